@@ -1,0 +1,40 @@
+// Sample frames for benchmarks: see the header.
+#include "sample_frames.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "toposlam/core/natural_order.hpp"
+
+namespace toposlam::cli {
+
+std::string defaultSamplesFolder() {
+  if (const char* env = std::getenv("TOPOSLAM_SAMPLES")) return env;
+  return TOPOSLAM_SAMPLES_DIR "/samples";
+}
+
+std::vector<cv::Mat> loadSampleFrames(const std::string& folder, cv::Size size) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(folder)) throw std::runtime_error(folder + ": not a folder of images");
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp") names.push_back(entry.path().string());
+  }
+  sortNatural(names);
+  std::vector<cv::Mat> frames;
+  for (const auto& name : names) {
+    cv::Mat image = cv::imread(name, cv::IMREAD_COLOR);
+    if (image.empty()) continue;
+    if (!size.empty() && image.size() != size) cv::resize(image, image, size, 0, 0, cv::INTER_AREA);
+    frames.push_back(image);
+  }
+  if (frames.empty()) throw std::runtime_error(folder + ": no readable images");
+  return frames;
+}
+
+}  // namespace toposlam::cli
