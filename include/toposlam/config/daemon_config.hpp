@@ -1,0 +1,62 @@
+// The one validated configuration of toposlamd (and of `toposlam` commands that run the pipeline):
+// every stage's config struct (defaults in code, validate() in its module) plus the daemon's own keys,
+// loaded once from YAML (config/toposlam.yaml documents every key). Unknown keys and out-of-range or
+// ill-typed values are refused at start with the key's full dotted name and its allowed range; absent
+// keys keep their defaults. No string look-ups happen after loading: stages get their structs by const
+// reference.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/pipeline/pipeline.hpp"
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/topology/topology_particle_filter.hpp"
+
+namespace toposlam {
+
+/// A bad configuration: what() names the key (full dotted path) and the allowed values.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct LcmSettings {
+  std::string url = "udpm://239.255.76.67:7667?ttl=0";  ///< ttl=0: multicast stays on this host
+  std::string place_channel = "TOPOSLAM_PLACE";          ///< place estimate, every frame
+  std::string place_event_channel = "TOPOSLAM_PLACE_EVENT";  ///< a place's step finished
+  std::string topology_channel = "TOPOSLAM_TOPOLOGY";    ///< most probable topology, when it changes
+  std::string status_channel = "TOPOSLAM_STATUS";        ///< pipeline status, every status period
+  std::string motion_channel = "TOPOSLAM_MOTION";        ///< input: robot motion
+  int jpeg_quality = 80;                                 ///< place-event thumbnails, 1 .. 100
+};
+
+struct DaemonConfig {
+  /// Frame source URI (see io/source_factory.hpp): images:PATH, video:FILE, sim:WORLD?..., v4l2:/dev/videoN.
+  std::string source = "sim:office?route=loop2";
+  LcmSettings lcm;
+  bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
+  bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
+  PipelineConfig pipeline;        ///< queues, threads, budgets; map.path and map.save_period_s land here
+  int fingerprint_workers = 2;    ///< fingerprint.workers: WorkerPool size incl. the fingerprint thread
+  VpackConfig fingerprint;
+  NgramSimilarityConfig similarity;
+  FiedlerSegmenterConfig segmentation;
+  TopologyFilterConfig topology;
+  int topology_slice_items = 256;  ///< topology.slice_items: work items per advance() slice, 1 .. 1000000
+  int topology_alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
+
+  DaemonConfig();
+  /// "" or "<full.dotted.key>: <problem, allowed range>" (also runs every stage's validate()).
+  std::string validate() const;
+};
+
+/// Parses YAML text onto the defaults. `origin` names the text in messages (a file name).
+/// Throws ConfigError on syntax errors, unknown keys, wrong types and out-of-range values.
+DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin = "config");
+/// Reads and parses a file; ConfigError if it cannot be read.
+DaemonConfig loadDaemonConfig(const std::string& path);
+
+}  // namespace toposlam

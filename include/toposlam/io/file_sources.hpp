@@ -1,0 +1,67 @@
+// Frame sources over files: an image folder or glob, played in natural order, and a video file.
+// Bad files (unreadable, truncated, undecodable) are skipped, counted and logged; the stream goes on.
+// Not thread-safe: one consumer calls next().
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/videoio.hpp>
+
+#include "toposlam/io/frame_source.hpp"
+
+namespace toposlam {
+
+/// True for .png, .jpg, .jpeg, .bmp (case-insensitive).
+bool isImageFileName(const std::string& name);
+/// True for .mp4, .avi, .mkv, .mov, .webm, .m4v, .mpg, .mpeg, .wmv (case-insensitive).
+bool isVideoFileName(const std::string& name);
+/// The image files of a folder, or the matches of a glob, or a single image file, in natural order.
+/// Throws FrameSourceError when nothing matches.
+std::vector<std::string> listImageFiles(const std::string& path_or_glob);
+/// True when the bytes of an image file look complete: JPEG ends with the EOI marker, PNG with IEND,
+/// BMP is as long as its header says. (Decoders often accept truncated files and fill the rest grey.)
+bool imageBytesLookComplete(const std::vector<unsigned char>& bytes);
+
+class ImageFilesSource : public FrameSource {
+ public:
+  /// timestamps are file index / timestamp_rate_hz (the bundled samples are ~1 Hz keyframes).
+  ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0);
+  std::string describe() const override;
+  std::optional<Frame> next() override;
+  std::int64_t skippedFrames() const override { return skipped_; }
+  std::int64_t frameCountHint() const override { return static_cast<std::int64_t>(files_.size()); }
+  const std::vector<std::string>& files() const { return files_; }
+
+ private:
+  std::string origin_;
+  std::vector<std::string> files_;
+  double rate_hz_;
+  std::size_t next_index_ = 0;
+  std::int64_t skipped_ = 0;
+};
+
+class VideoFileSource : public FrameSource {
+ public:
+  /// Throws FrameSourceError when the file cannot be opened. timestamp_rate_hz > 0 overrides the
+  /// container's timestamps with frame index / rate.
+  explicit VideoFileSource(const std::string& path, double timestamp_rate_hz = 0.0);
+  std::string describe() const override;
+  std::optional<Frame> next() override;
+  std::int64_t skippedFrames() const override { return skipped_; }
+  std::int64_t frameCountHint() const override { return frame_count_; }
+
+ private:
+  std::string path_;
+  cv::VideoCapture capture_;
+  double rate_hz_;
+  double container_fps_ = 0;
+  std::int64_t frame_count_ = -1;
+  std::int64_t next_index_ = 0;
+  std::int64_t skipped_ = 0;
+};
+
+}  // namespace toposlam

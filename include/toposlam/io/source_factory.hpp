@@ -1,0 +1,37 @@
+// Opening frame sources by URI, through a registry of scheme -> opener function.
+//
+// Built in: `images:PATH_OR_GLOB`, `video:FILE`, `sim:WORLD?route=R&fps=F&size=WxH&seed=S&...`, and a
+// plain path (a folder -> images, a video file -> video, an image file -> images). Other platform
+// adapters (v4l2, libcamera) call registerFrameSourceScheme() once at start-up, before opening.
+// The common query key `rate=HZ` plays the source in real time at that rate (the returned source sleeps
+// between frames); without it frames come as fast as they are asked for.
+// Thread-safety: registering and opening may be called from any thread (the registry is locked).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "toposlam/io/frame_source.hpp"
+#include "toposlam/io/source_uri.hpp"
+
+namespace toposlam {
+
+/// Builds a source from a parsed URI; throws FrameSourceError with an actionable message.
+using FrameSourceOpener = std::function<std::unique_ptr<FrameSource>(const SourceUri&)>;
+
+/// Adds or replaces a scheme (lower case letters, digits, '_' or '-'). `usage` is shown in errors,
+/// e.g. "v4l2:/dev/videoN?size=WxH&fps=F&format=F".
+void registerFrameSourceScheme(const std::string& scheme, FrameSourceOpener opener, const std::string& usage);
+/// Registered schemes with their usage strings, sorted by scheme.
+std::vector<std::pair<std::string, std::string>> registeredFrameSourceSchemes();
+
+/// Opens a source; throws FrameSourceError naming the unknown scheme, bad key or bad value.
+std::unique_ptr<FrameSource> openFrameSource(const std::string& uri);
+
+/// Wraps a source so next() returns frame k no earlier than k / rate_hz seconds after the first call
+/// (sleeps on a steady clock). Timestamps are left as the inner source set them.
+std::unique_ptr<FrameSource> makeRateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz);
+
+}  // namespace toposlam

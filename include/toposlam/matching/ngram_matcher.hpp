@@ -1,0 +1,139 @@
+// n-gram matching of two VPACK fingerprints (thesis section 3.3.1, Figure 3.9): the one engine behind
+// both the pairwise similarity (NgramSimilarity) and the localisation among places (PlaceLocalizer).
+//
+// Each subregion is a "letter". For a (reference, query) pair the engine
+//   1. matches histograms: for every reference letter j, the query letter i with the smallest normalised
+//      Hellinger distance d; kept if d <= max_hellinger_distance, letter score 1 - d;
+//   2. matches keypoints: for every query keypoint, its best match among all the reference's keypoints
+//      (Hamming distance for binary descriptors, L2 for float ones), kept if it passes the optional
+//      distance and ratio tests. Reference letter j and query letter i correspond when at least one
+//      keypoint of i matched a keypoint of j; the pair's score is the number of distinct keypoints of j
+//      matched from i over the number of keypoints in j;
+//   3. counts n-grams (n = 1, 2, 3) separately for histograms and keypoints: an n-gram is n consecutive
+//      reference letters j..j+n-1 corresponding to n consecutive query letters i..i+n-1 in the same
+//      order; it counts the average of its n pair scores. A reference n-gram is counted at most once:
+//      when several query positions i fit, the one with the largest average counts. So the count for n
+//      is at most the number of n-grams the reference could have had (reported beside it).
+// See docs/matching.md for the exact rules and measured numbers.
+//
+// Thread-safety: NgramMatcher is immutable after construction; all methods are const and may be called
+// concurrently. The hot path (counts()) allocates nothing once a thread's scratch buffers have grown to
+// the largest fingerprints seen (one thread_local MatchScratch per thread unless the caller passes one).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "toposlam/fingerprint/fingerprint.hpp"
+
+namespace toposlam {
+
+/// Unigrams, bigrams, trigrams (the thesis stops at 3, as usual in NLP).
+inline constexpr int kMaxNgramOrder = 3;
+
+struct NgramMatcherConfig {
+  /// Histograms match when the normalised Hellinger distance (in [0, 1]) is at most this (thesis: 0.3).
+  double max_hellinger_distance = 0.3;
+  /// Binary descriptors: a keypoint match is kept when its Hamming distance is at most this fraction of
+  /// the descriptor's bits (ORB: 256 bits, so 0.25 = 64 bits). 1 disables the test (thesis: optional).
+  double max_binary_distance_fraction = 0.25;
+  /// Float descriptors (SIFT, unnormalised, norms around 512): maximum L2 distance; 0 disables the test.
+  double max_float_distance = 0.0;
+  /// Lowe's ratio test: kept when best <= ratio * second best among the reference's keypoints.
+  /// 1 disables it. Default 0.9 (measured on the samples, docs/matching.md).
+  double ratio_test = 0.9;
+  /// Returns "" when valid, else "<key>: <problem, allowed range>".
+  std::string validate() const;
+};
+
+/// n-gram counts of one (reference, query) pair, index [n - 1] for n = 1, 2, 3.
+struct NgramCounts {
+  /// Sum over matched n-grams of the average of their letters' scores ("effective" n-grams).
+  std::array<double, kMaxNgramOrder> histogram{};
+  std::array<double, kMaxNgramOrder> keypoint{};
+  /// Number of matched n-grams (each counts 1 regardless of its score).
+  std::array<int, kMaxNgramOrder> histogram_matched{};
+  std::array<int, kMaxNgramOrder> keypoint_matched{};
+  /// n-grams the reference could have had: histograms, max(0, letters - n + 1); keypoints, windows of n
+  /// consecutive reference letters that all own at least one keypoint.
+  std::array<int, kMaxNgramOrder> histogram_possible{};
+  std::array<int, kMaxNgramOrder> keypoint_possible{};
+  int query_keypoints = 0;
+  int matched_keypoints = 0;  ///< query keypoints whose best match passed the tests
+};
+
+/// One corresponding letter pair with its score (for explanations, drawings and tests; not hot).
+struct LetterCorrespondence {
+  int reference_letter = 0;
+  int query_letter = 0;
+  double score = 0.0;  ///< histograms: 1 - d; keypoints: matched keypoints of the reference letter / its keypoints
+  int matched_keypoints = 0;  ///< keypoints only: distinct reference keypoints of the letter matched from the query letter
+};
+
+struct LetterCorrespondences {
+  std::vector<LetterCorrespondence> histogram;  ///< at most one per reference letter
+  std::vector<LetterCorrespondence> keypoint;   ///< any number per reference letter
+};
+
+/// Best match of one query keypoint among a reference's keypoints.
+struct DescriptorMatch {
+  int reference_keypoint = -1;  ///< row in the reference's descriptor matrix, -1 if it has none
+  float distance = 0.f;         ///< Hamming bits (binary) or L2 (float)
+  float second_distance = 0.f;  ///< second best distance, +infinity when there is none
+};
+
+/// Reusable buffers of the matcher. One per thread; never shared between threads at the same time.
+struct MatchScratch {
+  std::vector<double> reference_sqrt_histograms;  ///< letters x 13: sqrt(bin / sum of bins)
+  std::vector<double> query_sqrt_histograms;
+  std::vector<std::uint8_t> reference_histogram_empty;
+  std::vector<std::uint8_t> query_histogram_empty;
+  std::vector<float> histogram_scores;  ///< reference letters x query letters, 0 = no correspondence
+  std::vector<float> keypoint_scores;   ///< same layout
+  std::vector<std::uint64_t> reference_words;  ///< binary descriptors padded to whole 64-bit words
+  std::vector<std::uint64_t> query_words;
+  std::vector<int> reference_letter_of_keypoint;
+  std::vector<int> last_query_letter;  ///< per reference keypoint: last query letter that matched it
+  std::vector<int> pair_matches;       ///< reference letters x query letters, distinct matched keypoints
+  std::vector<DescriptorMatch> matches;  ///< per query keypoint
+};
+
+class NgramMatcher {
+ public:
+  /// Throws std::invalid_argument naming the bad key when the config is invalid.
+  explicit NgramMatcher(const NgramMatcherConfig& config = {});
+  const NgramMatcherConfig& config() const { return config_; }
+
+  /// n-gram counts of `query` against `reference`. scratch = nullptr uses this thread's own buffers.
+  /// Fingerprints with different descriptor types or lengths get no keypoint matches (histograms still
+  /// count). Never throws on well-formed fingerprints (Fingerprint::validate() == "").
+  NgramCounts counts(const Fingerprint& reference, const Fingerprint& query,
+                     MatchScratch* scratch = nullptr) const;
+
+  /// The letter correspondences behind counts() (allocates; for the CLI, drawings and tests).
+  LetterCorrespondences correspondences(const Fingerprint& reference, const Fingerprint& query) const;
+
+  /// Normalised Hellinger distance of two 13-bin histograms, in [0, 1] (eq. 3.3/3.4). Histograms are
+  /// divided by their sums first; two empty (all-zero) histograms are at distance 0, one empty at 1.
+  static double hellingerDistance(const HclHistogramBins& a, const HclHistogramBins& b);
+
+  /// Hamming distance of two binary descriptor rows of `bytes` bytes (any length).
+  static int hammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes);
+
+  /// Sum of the average pair scores of n-grams along diagonals of a (reference x query) score matrix
+  /// (row-major, 0 = no correspondence): the counting rule of step 3, exposed for tests.
+  /// matched receives the number of counted n-grams.
+  static double countNgrams(const float* scores, int reference_letters, int query_letters, int n,
+                            int* matched);
+
+ private:
+  void matchHistograms(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s) const;
+  /// Returns the number of query keypoints whose match was kept.
+  int matchKeypoints(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s) const;
+
+  NgramMatcherConfig config_;
+};
+
+}  // namespace toposlam

@@ -1,0 +1,90 @@
+// The real algorithms as pipeline stages: thin adapters from the stage interfaces (stages.hpp) to
+// VpackExtractor, FiedlerSegmenter and TopologyParticleFilter (+ MapStore). They hold no threads; each
+// is used by its one pipeline thread.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/pipeline/clock.hpp"
+#include "toposlam/pipeline/stages.hpp"
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/topology/topology_particle_filter.hpp"
+
+namespace toposlam {
+
+class WorkerPool;
+
+/// VPACK extraction; the per-subregion work runs on `pool` (borrowed; null = inline).
+class VpackFingerprintStage final : public FingerprintStage {
+ public:
+  VpackFingerprintStage(const VpackConfig& config, WorkerPool* pool) : extractor_(config, pool) {}
+  Fingerprint process(const cv::Mat& image) override { return extractor_.extract(image); }
+
+ private:
+  VpackExtractor extractor_;
+};
+
+/// FiedlerSegmenter. Keeps the thumbnails of the open place's frames (at most `max_thumbnails`, oldest
+/// dropped) so the closed place's representative has its picture. Dropped places (too few keypoints) are
+/// counted and not passed on.
+class FiedlerSegmentationStage final : public SegmentationStage {
+ public:
+  FiedlerSegmentationStage(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity,
+                           std::size_t max_thumbnails = 600);
+  SegmentationStep process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
+                           const cv::Mat& thumbnail) override;
+  std::int64_t droppedPlaces() const { return dropped_places_; }
+
+ private:
+  FiedlerSegmenter segmenter_;
+  std::size_t max_thumbnails_;
+  std::map<std::int64_t, cv::Mat> thumbnails_;  ///< frame -> thumbnail, frames of the open place
+  std::int64_t dropped_places_ = 0;
+};
+
+/// TopologyParticleFilter with its step sliced into `slice_items` work items, run until the time budget
+/// (read from `clock`) is spent. Place index = filter observation index, so numbering continues across
+/// restarts from a saved map. The map file (MapStore) carries, as application data, the representative
+/// frame of each observation.
+class ParticleFilterTopologyStage final : public TopologyStage {
+ public:
+  ParticleFilterTopologyStage(const TopologyFilterConfig& config, const SimilarityMeasure& similarity,
+                              const Clock& clock, int slice_items, int alternatives);
+  ~ParticleFilterTopologyStage() override;
+  /// Replaces the filter by the map saved at `path`. Throws MapStoreError (with the reason) if it is not
+  /// a valid map.
+  void loadMap(const std::string& path);
+
+  void enqueuePlace(const ClosedPlace& place) override;
+  std::optional<PlaceAssignment> advance(double budget_s) override;
+  bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
+  PlaceEstimate estimate() const override { return estimate_; }
+  TopologySnapshot topology() const override { return topology_; }
+  void saveMap(const std::string& path) const override;
+
+  int observations() const { return filter_->observationCount(); }
+
+ private:
+  void refresh();  ///< recomputes estimate_ and topology_ after a finished step (or a load)
+
+  const SimilarityMeasure& similarity_;
+  const Clock& clock_;
+  std::size_t slice_items_;
+  int alternatives_;
+  std::unique_ptr<TopologyParticleFilter> filter_;
+  std::deque<std::shared_ptr<const Fingerprint>> queue_;  ///< representatives waiting for their step
+  std::vector<std::int64_t> representative_frames_;        ///< per observation (-1: from an older run)
+  std::deque<std::int64_t> queued_frames_;
+  std::int64_t revision_ = 0;
+  PlaceEstimate estimate_;
+  TopologySnapshot topology_;
+};
+
+}  // namespace toposlam

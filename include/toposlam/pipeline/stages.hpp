@@ -1,0 +1,187 @@
+// The small interfaces the pipeline owns. Each stage of the real-time pipeline is one of these, so a test
+// can inject a fake (or a deliberately slow) stage and the daemon can wire in the real algorithms
+// (VpackExtractor, FiedlerSegmenter, TopologyParticleFilter) through thin adapters. The records that
+// travel between the stage threads are defined here too.
+//
+// Thread-safety: each stage object is used by exactly one pipeline thread (its own); sinks by the
+// publisher thread only. None of them needs to be thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "toposlam/fingerprint/fingerprint.hpp"
+#include "toposlam/io/frame_source.hpp"
+
+namespace toposlam {
+
+/// A place the segmentation closed (thesis chapter 4): its frames and its representative.
+struct ClosedPlace {
+  int place = -1;                         ///< index of the place, from 0, in closing order
+  std::int64_t first_frame = 0;           ///< sequence numbers
+  std::int64_t last_frame = 0;
+  std::int64_t representative_frame = 0;
+  int keypoints = 0;                      ///< keypoints of the representative
+  std::shared_ptr<const Fingerprint> representative;
+  cv::Mat thumbnail;                      ///< small BGR image of the representative (may be empty)
+};
+
+/// What segmentation says after one frame.
+struct SegmentationStep {
+  double lambda2 = std::numeric_limits<double>::quiet_NaN();  ///< Fiedler value; NaN until defined
+  std::optional<ClosedPlace> closed;                          ///< a place closed by this frame
+};
+
+/// The topology filter's decision for one place, once its (spread) step has finished.
+struct PlaceAssignment {
+  int place = -1;
+  int node = -1;
+  bool is_new = false;           ///< the node was created for this place
+  double probability = 0.0;      ///< probability of this node for this place (over particles)
+};
+
+struct NodeProbability {
+  int node = -1;
+  double probability = 0.0;
+};
+
+/// The per-frame place estimate: where the robot is, as of the last finished filter step.
+struct PlaceEstimate {
+  int place = -1;                ///< last place whose step finished (-1 before the first)
+  int node = -1;                 ///< its node in the most probable topology (-1 before the first)
+  double probability = 0.0;
+  bool is_new = false;
+  std::vector<NodeProbability> alternatives;  ///< next most probable nodes for that place, best first
+  std::int64_t map_revision = 0;              ///< increments with every finished step (and map load)
+};
+
+struct TopologyNode {
+  int id = -1;
+  std::vector<int> places;
+  std::vector<std::int64_t> representative_frames;
+};
+
+struct TopologyEdge {
+  int from = -1;
+  int to = -1;
+  int count = 0;  ///< traversals seen
+};
+
+/// The most probable topology (the best particle's map).
+struct TopologySnapshot {
+  std::int64_t map_revision = 0;
+  double probability = 0.0;  ///< weight of the best topology among the particles
+  int particles = 0;
+  std::vector<TopologyNode> nodes;
+  std::vector<TopologyEdge> edges;
+};
+
+// ---------------------------------------------------------------------------------------------------
+
+/// Frame -> fingerprint. Must not keep a reference to the frame's pixels after returning: the
+/// frame's buffer goes back to the source right after.
+class FingerprintStage {
+ public:
+  virtual ~FingerprintStage() = default;
+  virtual Fingerprint process(const cv::Mat& image) = 0;
+};
+
+/// Fingerprint -> Fiedler value and, now and then, a closed place. Called for every frame, in order.
+class SegmentationStage {
+ public:
+  virtual ~SegmentationStage() = default;
+  /// `thumbnail` is the frame's small image (for the place event of the place it may end up
+  /// representing); the stage may keep it (cv::Mat shares, no copy).
+  virtual SegmentationStep process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
+                                   const cv::Mat& thumbnail) = 0;
+};
+
+/// The topology filter, with its per-place step split into bounded slices of work.
+class TopologyStage {
+ public:
+  virtual ~TopologyStage() = default;
+  /// Queues the filter step for a newly closed place (places arrive in order).
+  virtual void enqueuePlace(const ClosedPlace& place) = 0;
+  /// Works on the queued steps for about `budget_s` seconds (it may overrun by one slice of work).
+  /// Returns the assignment when a place's step finished during this call (at most one per call).
+  virtual std::optional<PlaceAssignment> advance(double budget_s) = 0;
+  /// True when no step is queued or in progress.
+  virtual bool idle() const = 0;
+  /// The estimate as of the last finished step.
+  virtual PlaceEstimate estimate() const = 0;
+  /// The most probable topology as of the last finished step.
+  virtual TopologySnapshot topology() const = 0;
+  /// Replaces the map file at `path` atomically (readers and a crash see the old or the new map, never
+  /// half of one). Only called when idle(). Throws std::runtime_error (or a subclass) on I/O failure.
+  virtual void saveMap(const std::string& path) const = 0;
+};
+
+// ---------------------------------------------------------------------------------------------------
+
+/// Latency statistics over a window of frames, in milliseconds.
+struct LatencyStats {
+  double median_ms = 0.0;
+  double p99_ms = 0.0;
+  double max_ms = 0.0;
+  std::int64_t samples = 0;
+};
+
+struct StageStatus {
+  std::string name;
+  LatencyStats latency;         ///< this stage's own processing time per frame, last status period
+  std::int64_t processed = 0;   ///< frames this stage finished since start
+  std::int64_t dropped = 0;     ///< frames dropped from this stage's INPUT queue since start
+  std::size_t queue_depth = 0;  ///< items waiting in its input queue now
+  std::size_t queue_capacity = 0;
+  double cpu_percent = 0.0;     ///< CPU time of the stage's thread over the last period (100 = one core)
+};
+
+struct PipelineStatus {
+  double time_s = 0.0;          ///< pipeline clock
+  double uptime_s = 0.0;
+  double fps = 0.0;             ///< frames published per second over the last period
+  std::int64_t frames_captured = 0;
+  std::int64_t frames_published = 0;
+  std::int64_t frames_dropped = 0;   ///< all queues together
+  std::int64_t source_skipped = 0;   ///< bad frames the source skipped
+  LatencyStats latency;              ///< capture to publish, last period
+  std::vector<StageStatus> stages;   ///< capture, fingerprint, segmentation, topology, publisher
+  double cpu_percent = 0.0;          ///< whole process, last period (100 = one core)
+  int places = 0;                    ///< places closed so far
+  std::int64_t map_revision = 0;
+  std::int64_t maps_saved = 0;
+  std::string state;                 ///< "running", "stopping", "finished"
+};
+
+/// One frame's passage through the pipeline, delivered to the sink after the topology stage.
+struct FrameResult {
+  bool has_frame = true;        ///< false for the final flush record (only events and topology)
+  std::int64_t sequence = 0;
+  double source_time_s = 0.0;   ///< Frame::timestamp_s from the source
+  double captured_at_s = 0.0;   ///< pipeline clock when the frame left the source
+  std::string name;
+  double fingerprint_ms = 0.0, segmentation_ms = 0.0, filter_ms = 0.0;  ///< per-stage work
+  int keypoints = 0;
+  double lambda2 = std::numeric_limits<double>::quiet_NaN();
+  std::optional<ClosedPlace> closed_place;  ///< closed by segmentation on this frame (its step is queued)
+  PlaceEstimate estimate;
+  std::vector<std::pair<ClosedPlace, PlaceAssignment>> finished_places;  ///< steps finished on this frame
+  std::shared_ptr<const TopologySnapshot> topology;  ///< set when the topology changed on this frame
+};
+
+/// Where results go (LCM in the daemon; a recorder in tests and the benchmark).
+class PipelineSink {
+ public:
+  virtual ~PipelineSink() = default;
+  /// Per frame (has_frame) or final flush; publishes the place estimate, place events and topology.
+  virtual void publish(const FrameResult& result) = 0;
+  virtual void publishStatus(const PipelineStatus& status) = 0;
+};
+
+}  // namespace toposlam

@@ -1,0 +1,179 @@
+// Online place segmentation by algebraic connectivity (thesis chapter 4).
+//
+// Each new frame joins a sliding window of the last n frames (default 25). Only its similarities with
+// the other n-1 frames are computed (2 (n-1) calls to SimilarityMeasure::similarity, the mean of both
+// directions); the rest of the symmetric affinity matrix A (zero diagonal) is cached. The window is a
+// ring: a frame keeps its slot (row/column of A) until it leaves, and since eigenvalues do not depend on
+// the order of the nodes, A is never shifted. From A: degrees d_i = sum_j a_ij, the normalised
+// symmetric Laplacian L_sym = I - D^-1/2 A D^-1/2, and its second-smallest eigenvalue lambda2 (the
+// Fiedler value, Eigen's SelfAdjointEigenSolver). lambda2 feeds the valley detector (Algorithm 4.1);
+// a confirmed valley closes the open place.
+//
+// Degenerate windows: a frame with degree 0 (similarity 0 with every other frame) is an isolated node.
+// For it D^-1/2 is defined as 0 and, following Chung, its diagonal entry of L_sym as 0 too, so an
+// isolated node is a connected component of its own (eigenvalue 0) and lambda2 of a disconnected
+// window is 0. All-zero similarities therefore give lambda2 = 0. A window of one frame has no lambda2.
+//
+// Where a place ends (CutPlacement): the valley of lambda2 is the moment the window is split most
+// evenly between two places, i.e. about n/2 frames after the robot changed place. WindowSplit (the
+// default) therefore cuts the window of the valley frame at its best temporal split: the border that
+// minimises the normalised cut cut(S, T) (1/vol S + 1/vol T) of S = older frames and T = newer ones
+// (the sparsest cut the Fiedler vector approximates, restricted to splits in time). ValleyFrame is the
+// literal reading of Algorithm 4.1: the place ends at the valley frame itself.
+//
+// Representative (section 4.2.3): after every frame, the window frame (of the open place) with the
+// largest degree is remembered with that degree; when a place closes, its representative is the
+// remembered candidate with the largest degree inside the place (ties: the earliest frame). So that a
+// short place always has a candidate, the moment the detector records a new lambda2 minimum (the
+// future border) also remembers the best window frame before that border. A place whose
+// representative has fewer than `min_keypoints` keypoints is reported as dropped. Candidates older than
+// any possible future border all fall in the open place, so only their best is kept: memory stays
+// O(window) except while a valley candidate waits for confirmation.
+//
+// Deterministic; independent of time (timestamps are passed through). Not thread-safe: one instance
+// per stream. After the window is full, addFrame() does not allocate, closing places included
+// (test_segmentation_alloc counts malloc calls); the similarity measure's own allocations aside.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "toposlam/fingerprint/fingerprint.hpp"
+#include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/segmentation/valley_detector.hpp"
+
+namespace toposlam {
+
+enum class CutPlacement : std::uint8_t {
+  WindowSplit = 0,  ///< border at the best temporal normalised cut of the valley frame's window
+  ValleyFrame = 1,  ///< the place ends at the valley frame (Algorithm 4.1 read literally)
+};
+const char* toString(CutPlacement placement);
+/// Parses "window-split" or "valley-frame"; throws std::invalid_argument otherwise.
+CutPlacement parseCutPlacement(const std::string& name);
+
+struct FiedlerSegmenterConfig {
+  int window = 25;  ///< frames in the sliding window (thesis: 25; allowed [3, 1000])
+  /// Peak/valley thresholds on lambda2. Thesis: gamma 0.5, delta 0.25 (see docs/segmentation.md for
+  /// how they relate to our similarity scale).
+  ValleyDetectorConfig valley;
+  int min_keypoints = 15;  ///< places whose representative has fewer keypoints are dropped (thesis: 15)
+  CutPlacement cut_placement = CutPlacement::WindowSplit;
+  /// Returns "" when valid, else "<key>: <problem, allowed range>".
+  std::string validate() const;
+};
+
+/// The largest Fiedler value of L_sym for n nodes (a complete graph): n / (n - 1) (thesis eq. 4.6).
+double maxFiedlerValue(int nodes);
+
+/// Fiedler value of a symmetric, non-negative affinity matrix (diagonal ignored), with the degree-0
+/// convention above. Throws std::invalid_argument for a non-square matrix; 0 for fewer than 2 nodes.
+double fiedlerValue(const Eigen::MatrixXd& affinity);
+
+/// A closed place: frames [first_frame, last_frame] of the stream.
+struct SegmentedPlace {
+  std::int64_t first_frame = 0;
+  std::int64_t last_frame = 0;
+  double first_time_s = 0.0;
+  double last_time_s = 0.0;
+  std::int64_t representative_frame = 0;
+  double representative_degree = 0.0;  ///< its degree in the window it was remembered from
+  std::shared_ptr<const Fingerprint> representative;
+  int representative_keypoints = 0;
+  bool dropped = false;            ///< representative had fewer than min_keypoints keypoints
+  std::int64_t valley_frame = -1;  ///< frame of the lambda2 valley that closed it; -1 when flushed
+  /// Sequence number among kept places (dropped == false) or among dropped places, from 0.
+  std::int64_t index = 0;
+};
+
+/// What one addFrame() produced.
+struct SegmenterStep {
+  std::int64_t frame = 0;
+  std::optional<double> lambda2;               ///< empty while the window holds one frame
+  std::optional<SegmentedPlace> closed_place;  ///< a place closed by a valley confirmed at this frame
+};
+
+class FiedlerSegmenter {
+ public:
+  /// `similarity` must outlive the segmenter. Throws std::invalid_argument on an invalid config.
+  FiedlerSegmenter(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity);
+
+  /// Adds the next frame. frame_index must increase strictly (gaps are allowed); throws
+  /// std::invalid_argument otherwise or when `fingerprint` is null.
+  SegmenterStep addFrame(std::int64_t frame_index, double time_s,
+                         std::shared_ptr<const Fingerprint> fingerprint);
+
+  /// End of stream: closes the open place (if it has frames) and returns it. Frames added afterwards
+  /// start a new place; the window and the detector keep their state.
+  std::optional<SegmentedPlace> flush();
+
+  const FiedlerSegmenterConfig& config() const { return config_; }
+  /// Frames currently in the window (<= config().window).
+  int windowFrames() const { return count_; }
+  /// First frame of the open place, or -1 before any frame.
+  std::int64_t openPlaceStart() const { return place_start_; }
+  /// Valleys that could not close a place (their best split fell before the open place started).
+  std::int64_t ignoredValleys() const { return ignored_valleys_; }
+  /// Current cached affinity matrix, rows/columns in window order (oldest first); for tests and plots.
+  Eigen::MatrixXd affinityInWindowOrder() const;
+
+ private:
+  struct Candidate {
+    std::int64_t frame;
+    double degree;
+    double time_s;
+    std::shared_ptr<const Fingerprint> fingerprint;
+  };
+
+  int slotAtPosition(int position) const;  ///< window position 0 = oldest frame
+  double computeLambda2();
+  /// Remembers the window frame with the largest degree among frames in [from_frame, before_frame).
+  void rememberBestWindowFrame(std::int64_t from_frame, std::int64_t before_frame);
+  void addCandidate(const Candidate& candidate);
+  void compactCandidates();
+  /// Window position of the first frame of the newer part at the best split; -1 when none qualifies.
+  int bestSplitPosition() const;
+  /// Closes the open place: at the pending border (valley_frame >= 0) or at the newest frame (-1).
+  SegmentedPlace closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
+                            double next_start_time_s);
+
+  FiedlerSegmenterConfig config_;
+  const SimilarityMeasure& similarity_;
+  ValleyDetector detector_;
+
+  // Ring window: slot s holds frame slot_frame_[s]; next_slot_ is where the next frame goes.
+  int count_ = 0;
+  int next_slot_ = 0;
+  std::vector<std::shared_ptr<const Fingerprint>> slot_fingerprint_;
+  std::vector<std::int64_t> slot_frame_;
+  std::vector<double> slot_time_;
+  Eigen::MatrixXd affinity_;  ///< n x n, symmetric, zero diagonal; rows of empty slots are 0
+  Eigen::VectorXd degree_;    ///< n
+  Eigen::VectorXd inv_sqrt_degree_;
+  Eigen::MatrixXd laplacian_;  ///< n x n scratch
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver_;
+
+  std::int64_t last_frame_ = -1;
+  double last_time_s_ = 0.0;
+  std::int64_t place_start_ = -1;
+  double place_start_time_s_ = 0.0;
+  // Representative candidates of the open place (and of frames after a pending border), in
+  // insertion order; one record per distinct frame.
+  std::vector<Candidate> candidates_;
+  // The border the detector's current minimum would produce: recorded when the minimum was recorded.
+  std::int64_t pending_min_frame_ = -1;     ///< detector minimum this border belongs to
+  std::int64_t pending_border_frame_ = -1;  ///< first frame of the next place; -1 = not known yet
+  double pending_border_time_s_ = 0.0;
+  std::int64_t pending_last_frame_ = -1;  ///< last frame of the closing place at that border
+  double pending_last_time_s_ = 0.0;
+  std::int64_t kept_places_ = 0;
+  std::int64_t dropped_places_ = 0;
+  std::int64_t ignored_valleys_ = 0;
+};
+
+}  // namespace toposlam

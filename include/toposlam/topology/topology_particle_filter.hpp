@@ -1,0 +1,210 @@
+// Topological SLAM with a particle filter over topologies (thesis chapter 5, docs/topology.md).
+//
+// Every new place representative is one time step k. A particle is one hypothesis of the whole node
+// assignment sequence L_1..L_k (a "topology": which observations show the same node). Per step:
+//   1. the similarity of the new representative with every representative still stored by some particle
+//      is computed ONCE (SimilarityMeasure::similarity(reference = stored, query = new));
+//   2. each particle proposes its next node from the transition model: eq. 5.8 from a node without
+//      adjacency information (never left yet), else the gamma(k = 10, theta = 0.25) model over "stay",
+//      1st, 2nd, ... successor plus a fixed probability of a new node;
+//   3. its weight is the appearance likelihood: for a known node m the max similarity over the
+//      representatives this particle gave m; for a new node eta * (1 - max_m), eta the normalised entropy
+//      of the normalised known-node likelihoods (eq. 5.6/5.7; eta = 1 with a single known node);
+//   4. systematic resampling; 5. map update: the surviving particles append the representative to their
+//      node, keeping at most max_representatives_per_node (the oldest is dropped).
+//
+// Successors (our reading, see docs/topology.md): successor j of node c is the j-th distinct node (other
+// than c) the particle visited after it last left c, followed by the remembered successors of earlier
+// visits, at most max_successors of them.
+//
+// Sharing: particles hold a pointer to an immutable, reference-counted topology state; states share their
+// history (a linked list of assignment records) and their node tables (a persistent radix trie with path
+// copying). Particles that propose the same node from the same state share one child state, so two
+// particles hold the same state exactly when they agree on the whole assignment sequence. Per step, work
+// and new memory are O(distinct states x (log N + max_successors^2) + stored representatives + M), never
+// O(particles x history length). Likelihood aggregates are memoised per trie node and step.
+//
+// Determinism: all randomness comes from one std::mt19937_64 seeded from the config and saved with the
+// map; the same input and seed give the same output bit for bit, however the step is sliced.
+//
+// Thread-safety: none; one instance per map, used from one thread. The SimilarityMeasure must outlive it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <iosfwd>
+#include <memory>
+#include <random>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "toposlam/fingerprint/fingerprint.hpp"
+#include "toposlam/matching/similarity_measure.hpp"
+
+namespace toposlam {
+
+namespace topology_detail {
+struct TopologyState;
+struct HistoryRecord;
+class TrieNode;
+}  // namespace topology_detail
+
+/// Largest allowed max_successors and max_representatives_per_node (fixed-size node entries).
+inline constexpr int kTopologyMaxSuccessors = 8;
+inline constexpr int kTopologyMaxRepresentatives = 16;
+
+struct TopologyFilterConfig {
+  int particles = 500;                   ///< M (thesis: 500); allowed [1, 1000000]
+  double alpha = 15.0;                   ///< prior map size of eq. 5.8 (thesis: 15); allowed (0, 1e6]
+  double new_node_probability = 0.05;    ///< from a known node (thesis: "e.g. 0.05"); allowed (0, 1)
+  double gamma_shape = 10.0;             ///< k of the successor gamma pdf (thesis: 10); allowed (0, 1000]
+  double gamma_scale = 0.25;             ///< theta (thesis: 0.25); allowed (0, 100]
+  int max_successors = 5;                ///< successors proposed from a known node; allowed [1, 8]
+  int max_representatives_per_node = 8;  ///< per node and particle, oldest dropped; allowed [1, 16]
+  /// Literal "no return to the previous node": also drop the node visited just before the current one
+  /// from the successor candidates. Off by default: the successor model never proposes a node that only
+  /// preceded the current one anyway, and one that also followed it earlier is a forward move (see docs).
+  bool forbid_return_to_previous = false;
+  std::uint64_t seed = 1;  ///< of the filter's std::mt19937_64
+  /// Returns "" when valid, else "<key>: <problem, allowed range>".
+  std::string validate() const;
+};
+
+/// Gamma pdf with shape k and scale theta at x > 0.
+double gammaPdf(double x, double shape, double scale);
+
+/// Normalised entropy (eq. 5.6) of likelihoods after normalising them to sum 1, in [0, 1]. 1 for fewer
+/// than two values or when all are zero (no information).
+double normalisedEntropy(std::span<const double> likelihoods);
+
+/// Appearance likelihood of a new node (eq. 5.7): eta * (1 - max). 1 with no known node.
+double newNodeLikelihood(std::span<const double> known_likelihoods);
+
+/// The known-node transition weights: stay[0] = weight of staying, successor[j-1] of the j-th successor,
+/// for j = 1..max_successors. They are gammaPdf(j + 1) scaled so stay + all successors = 1 - new_node.
+struct KnownNodeTransition {
+  double stay = 0.0;
+  std::vector<double> successor;
+  double new_node = 0.0;  ///< the fixed part; missing successors add their weight to it
+};
+KnownNodeTransition knownNodeTransition(const TopologyFilterConfig& config);
+
+/// One distinct topology held by some particles.
+struct TopologyHypothesis {
+  std::vector<int> assignment;  ///< node of each observation, nodes numbered in order of creation
+  double probability = 0.0;     ///< share of particles holding exactly this assignment
+  int node_count = 0;
+  int current_node = -1;      ///< assignment.back()
+  int first_difference = -1;  ///< first observation where it differs from the best (-1: it is it)
+};
+
+/// Where the robot is: "the node first seen at observation `founding_observation`".
+struct LocationHypothesis {
+  int founding_observation = -1;  ///< first observation of the current node in those particles
+  int node_in_best = -1;          ///< that node's id in the best topology, -1 if it has none there
+  double probability = 0.0;       ///< share of particles whose current node has this founding observation
+};
+
+struct TopologyEstimate {
+  int observations = 0;
+  TopologyHypothesis best;                       ///< most particles agree on it (ties: first particle)
+  std::vector<TopologyHypothesis> alternatives;  ///< the next most probable topologies, descending
+  int current_node = -1;                         ///< in the best topology
+  double current_node_probability = 0.0;         ///< share of particles at the same node (founding obs)
+  std::vector<LocationHypothesis> locations;     ///< all current-node hypotheses, descending
+  double effective_sample_size = 0.0;            ///< of the last step's weights (1 / sum w^2, normalised)
+  int distinct_topologies = 0;
+};
+
+/// Sizes of the shared structures, for tests and benchmarks (counts reachable objects: O(size)).
+struct TopologyMemoryStats {
+  std::size_t distinct_states = 0;
+  std::size_t history_records = 0;  ///< live assignment records (shared by all particles)
+  std::size_t trie_nodes = 0;       ///< live node-table trie nodes (shared)
+  std::size_t stored_fingerprints = 0;
+};
+
+class TopologyParticleFilter {
+ public:
+  /// Throws std::invalid_argument with config.validate()'s message when invalid.
+  TopologyParticleFilter(const TopologyFilterConfig& config, const SimilarityMeasure& similarity);
+  ~TopologyParticleFilter();
+  TopologyParticleFilter(const TopologyParticleFilter&) = delete;
+  TopologyParticleFilter& operator=(const TopologyParticleFilter&) = delete;
+
+  /// Starts the step for a new representative. Throws std::logic_error while a step is in progress and
+  /// std::invalid_argument for a null fingerprint.
+  void beginStep(std::shared_ptr<const Fingerprint> representative);
+  /// Runs at most `budget` work items of the current step (>= 1; one item = one similarity evaluation,
+  /// one distinct topology scanned or aggregated, or one particle proposed/weighted/updated). Returns
+  /// true when the step is complete (also when no step is in progress). Sliced and whole runs of a step
+  /// give identical results.
+  bool advance(std::size_t budget);
+  /// beginStep + advance until done.
+  void step(std::shared_ptr<const Fingerprint> representative);
+  bool stepInProgress() const { return phase_ != Phase::Idle; }
+
+  const TopologyFilterConfig& config() const { return config_; }
+  int observationCount() const { return observation_count_; }  ///< completed steps
+  /// Summary of the current particles (call between steps). O(M + history x alternatives).
+  TopologyEstimate estimate(int alternatives = 4) const;
+  /// Assignment sequence of particle i (for tests).
+  std::vector<int> particleAssignment(int i) const;
+  double lastEffectiveSampleSize() const { return last_ess_; }
+  /// Steps whose weights were all zero (resampled uniformly).
+  std::int64_t degenerateSteps() const { return degenerate_steps_; }
+  TopologyMemoryStats memoryStats() const;
+  /// Representatives still referenced by some particle (the ones step 1 compares against).
+  std::shared_ptr<const Fingerprint> storedRepresentative(int observation) const;
+
+  /// Binary state (config, RNG, fingerprints, history, particles). Throws std::logic_error during a
+  /// step. Little-endian; framed, versioned and checksummed by MapStore.
+  void saveState(std::ostream& out) const;
+  /// Inverse of saveState; throws std::runtime_error on malformed data.
+  static std::unique_ptr<TopologyParticleFilter> loadState(std::istream& in,
+                                                           const SimilarityMeasure& similarity);
+
+ private:
+  enum class Phase : std::uint8_t { Idle, Collect, Similarity, Aggregate, Propose, Resample, Update };
+  using StatePtr = std::shared_ptr<const topology_detail::TopologyState>;
+
+  double uniform01();
+  void finishStep();
+
+  TopologyFilterConfig config_;
+  const SimilarityMeasure& similarity_;
+  std::mt19937_64 rng_;
+  KnownNodeTransition transition_;
+
+  int observation_count_ = 0;
+  std::uint64_t stamp_ = 0;  ///< memo key of the trie aggregates, one per step
+  std::vector<std::shared_ptr<const Fingerprint>> fingerprints_;  ///< by observation; null = dropped
+  std::vector<StatePtr> particles_;
+  double last_ess_ = 0.0;
+  std::int64_t degenerate_steps_ = 0;
+
+  // Step in progress.
+  Phase phase_ = Phase::Idle;
+  std::size_t cursor_ = 0;
+  std::shared_ptr<const Fingerprint> pending_;
+  std::vector<StatePtr> groups_;        ///< distinct parent states, in order of first particle
+  std::vector<std::int32_t> group_of_;  ///< per particle
+  std::vector<unsigned char> needed_;   ///< per observation: referenced by some group
+  std::vector<std::int32_t> needed_list_;
+  std::vector<double> similarity_of_;  ///< per observation, this step
+  struct GroupStats {
+    double max = 0.0;
+    double new_likelihood = 1.0;
+  };
+  std::vector<GroupStats> group_stats_;
+  std::vector<std::int32_t> proposal_;  ///< per particle: node (== node_count for a new node)
+  std::vector<double> weight_;
+  std::vector<std::int32_t> chosen_;  ///< resampled particle indices
+  std::vector<StatePtr> next_particles_;
+  std::unordered_map<std::uint64_t, std::int32_t> child_index_;  ///< (group, node) -> child
+  std::vector<StatePtr> children_;
+};
+
+}  // namespace toposlam

@@ -1,0 +1,190 @@
+// Image-folder/glob and video-file frame sources (file_sources.hpp).
+#include "toposlam/io/file_sources.hpp"
+
+#include <glob.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "toposlam/core/natural_order.hpp"
+
+namespace toposlam {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lowerExtension(const std::string& name) {
+  std::string extension = fs::path(name).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return extension;
+}
+
+bool hasGlobCharacters(const std::string& text) { return text.find_first_of("*?[") != std::string::npos; }
+
+/// Natural order by file name, then by the whole path (files of one folder sort as "2.jpg" < "10.jpg").
+void sortFilesNaturally(std::vector<std::string>& files) {
+  std::stable_sort(files.begin(), files.end(), [](const std::string& a, const std::string& b) {
+    const std::string name_a = fs::path(a).filename().string(), name_b = fs::path(b).filename().string();
+    if (name_a != name_b) return naturalLess(name_a, name_b);
+    return naturalLess(a, b);
+  });
+}
+
+std::uint32_t readLe32(const std::vector<unsigned char>& bytes, std::size_t offset) {
+  return static_cast<std::uint32_t>(bytes[offset]) | (static_cast<std::uint32_t>(bytes[offset + 1]) << 8) |
+         (static_cast<std::uint32_t>(bytes[offset + 2]) << 16) | (static_cast<std::uint32_t>(bytes[offset + 3]) << 24);
+}
+
+}  // namespace
+
+bool isImageFileName(const std::string& name) {
+  const std::string extension = lowerExtension(name);
+  return extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp";
+}
+
+bool isVideoFileName(const std::string& name) {
+  static const char* const kExtensions[] = {".mp4", ".avi", ".mkv", ".mov", ".webm", ".m4v", ".mpg", ".mpeg", ".wmv"};
+  const std::string extension = lowerExtension(name);
+  return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return extension == e; });
+}
+
+std::vector<std::string> listImageFiles(const std::string& path_or_glob) {
+  std::vector<std::string> files;
+  std::error_code error;
+  if (fs::is_directory(path_or_glob, error)) {
+    for (const fs::directory_entry& entry : fs::directory_iterator(path_or_glob, error)) {
+      if (entry.is_regular_file(error) && isImageFileName(entry.path().filename().string())) {
+        files.push_back(entry.path().string());
+      }
+    }
+    if (error) throw FrameSourceError("images: cannot list folder '" + path_or_glob + "': " + error.message());
+    if (files.empty()) {
+      throw FrameSourceError("images: no .png/.jpg/.jpeg/.bmp files in folder '" + path_or_glob + "'");
+    }
+  } else if (hasGlobCharacters(path_or_glob)) {
+    glob_t matches{};
+    const int result = ::glob(path_or_glob.c_str(), GLOB_NOSORT, nullptr, &matches);
+    if (result == 0) {
+      for (std::size_t i = 0; i < matches.gl_pathc; ++i) {
+        const std::string match = matches.gl_pathv[i];
+        if (fs::is_regular_file(match, error) && isImageFileName(match)) files.push_back(match);
+      }
+    }
+    globfree(&matches);
+    if (files.empty()) throw FrameSourceError("images: no image files match '" + path_or_glob + "'");
+  } else if (fs::is_regular_file(path_or_glob, error)) {
+    if (!isImageFileName(path_or_glob)) {
+      throw FrameSourceError("images: '" + path_or_glob + "' is not a .png/.jpg/.jpeg/.bmp file");
+    }
+    files.push_back(path_or_glob);
+  } else {
+    throw FrameSourceError("images: '" + path_or_glob + "' is neither a folder, an image file nor a matching glob");
+  }
+  sortFilesNaturally(files);
+  return files;
+}
+
+bool imageBytesLookComplete(const std::vector<unsigned char>& bytes) {
+  const std::size_t n = bytes.size();
+  if (n < 16) return false;
+  if (bytes[0] == 0xFF && bytes[1] == 0xD8) {  // JPEG: the EOI marker near the end (some writers pad)
+    const std::size_t from = n > 64 ? n - 64 : 0;
+    for (std::size_t i = n - 1; i > from; --i) {
+      if (bytes[i - 1] == 0xFF && bytes[i] == 0xD9) return true;
+    }
+    return false;
+  }
+  if (bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G') {  // PNG: an IEND chunk
+    const std::size_t from = n > 64 ? n - 64 : 0;
+    for (std::size_t i = from; i + 4 <= n; ++i) {
+      if (bytes[i] == 'I' && bytes[i + 1] == 'E' && bytes[i + 2] == 'N' && bytes[i + 3] == 'D') return true;
+    }
+    return false;
+  }
+  if (bytes[0] == 'B' && bytes[1] == 'M') return readLe32(bytes, 2) <= n;  // BMP: declared size
+  return true;  // unknown format: let the decoder decide
+}
+
+ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz)
+    : origin_(path_or_glob), files_(listImageFiles(path_or_glob)), rate_hz_(timestamp_rate_hz) {
+  if (!(rate_hz_ > 0)) throw FrameSourceError("images: rate must be > 0 Hz");
+}
+
+std::string ImageFilesSource::describe() const {
+  return "images:" + origin_ + " (" + std::to_string(files_.size()) + " frames)";
+}
+
+std::optional<Frame> ImageFilesSource::next() {
+  while (next_index_ < files_.size()) {
+    const std::size_t index = next_index_++;
+    const std::string& file = files_[index];
+    std::ifstream in(file, std::ios::binary);
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    cv::Mat image;
+    if (in.bad() || !imageBytesLookComplete(bytes)) {
+      spdlog::warn("images: skipping '{}': unreadable or truncated ({} bytes)", file, bytes.size());
+    } else {
+      image = cv::imdecode(bytes, cv::IMREAD_COLOR);
+      if (image.empty()) spdlog::warn("images: skipping '{}': cannot decode it", file);
+    }
+    if (image.empty()) {
+      ++skipped_;
+      continue;
+    }
+    Frame frame;
+    frame.image = image;
+    frame.sequence = static_cast<std::int64_t>(index);
+    frame.timestamp_s = static_cast<double>(index) / rate_hz_;
+    frame.name = fs::path(file).filename().string();
+    return frame;
+  }
+  return std::nullopt;
+}
+
+VideoFileSource::VideoFileSource(const std::string& path, double timestamp_rate_hz)
+    : path_(path), rate_hz_(timestamp_rate_hz) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) throw FrameSourceError("video: no such file '" + path + "'");
+  if (!capture_.open(path) || !capture_.isOpened()) {
+    throw FrameSourceError("video: cannot open '" + path + "' (unsupported container or codec?)");
+  }
+  container_fps_ = capture_.get(cv::CAP_PROP_FPS);
+  const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+  frame_count_ = count > 0 ? static_cast<std::int64_t>(count) : -1;
+}
+
+std::string VideoFileSource::describe() const {
+  return "video:" + path_ + " (" + (frame_count_ >= 0 ? std::to_string(frame_count_) : std::string("?")) + " frames)";
+}
+
+std::optional<Frame> VideoFileSource::next() {
+  cv::Mat image;
+  if (!capture_.read(image) || image.empty()) return std::nullopt;
+  Frame frame;
+  const std::int64_t index = next_index_++;
+  if (image.type() != CV_8UC3) {
+    ++skipped_;
+    spdlog::warn("video: skipping frame {} of '{}': unexpected pixel type", index, path_);
+    return next();
+  }
+  frame.image = image;
+  frame.sequence = index;
+  if (rate_hz_ > 0) {
+    frame.timestamp_s = static_cast<double>(index) / rate_hz_;
+  } else if (container_fps_ > 0) {
+    frame.timestamp_s = static_cast<double>(index) / container_fps_;
+  } else {
+    frame.timestamp_s = capture_.get(cv::CAP_PROP_POS_MSEC) / 1000.0;
+  }
+  return frame;
+}
+
+}  // namespace toposlam

@@ -1,0 +1,372 @@
+// LCM sink and subscriber: pipeline records <-> the generated toposlam_lcm message types.
+#include "toposlam/platform/lcm_transport.hpp"
+
+#include <time.h>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "toposlam/core/json_writer.hpp"
+#include "toposlam_lcm/motion_t.hpp"
+#include "toposlam_lcm/place_event_t.hpp"
+#include "toposlam_lcm/place_t.hpp"
+#include "toposlam_lcm/status_t.hpp"
+#include "toposlam_lcm/topology_t.hpp"
+
+namespace toposlam {
+
+namespace {
+
+std::int64_t toMicroseconds(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e6)); }
+
+// Encodes `message` into `buffer` (grown once to the largest size seen; no allocation afterwards).
+template <typename Message>
+int encodeInto(const Message& message, std::vector<std::uint8_t>& buffer) {
+  const int size = message.getEncodedSize();
+  if (buffer.size() < static_cast<std::size_t>(size)) buffer.resize(static_cast<std::size_t>(size));
+  return message.encode(buffer.data(), 0, size);
+}
+
+float asFloat(double v) { return static_cast<float>(v); }
+
+}  // namespace
+
+std::int64_t monotonicMicroseconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+
+std::unique_ptr<lcm::LCM> openLcm(const std::string& url) {
+  auto instance = std::make_unique<lcm::LCM>(url);
+  if (!instance->good())
+    throw std::runtime_error("cannot open LCM at '" + url +
+                             "': check the URL (e.g. udpm://239.255.76.67:7667?ttl=0) and that the host has a "
+                             "multicast route (for loopback only: ip link set lo multicast on; "
+                             "ip route add 224.0.0.0/4 dev lo)");
+  return instance;
+}
+
+// --------------------------------------------------------------------------------------------------------
+
+LcmPipelineSink::LcmPipelineSink(const std::string& url, LcmChannels channels, int jpeg_quality,
+                                 const std::atomic<std::int64_t>* motion_messages)
+    : lcm_(openLcm(url)),
+      channels_(std::move(channels)),
+      jpeg_params_{cv::IMWRITE_JPEG_QUALITY, jpeg_quality},
+      motion_messages_(motion_messages) {
+  buffer_.reserve(64 * 1024);
+  jpeg_.reserve(32 * 1024);
+}
+
+LcmPipelineSink::~LcmPipelineSink() = default;
+
+void LcmPipelineSink::send(const std::string& channel, const void* data, int size) {
+  if (size < 0 || lcm_->publish(channel, data, static_cast<unsigned>(size)) != 0) {
+    if (failures_++ % 100 == 0) spdlog::warn("lcm: publishing on {} failed ({} failures so far)", channel, failures_);
+  }
+}
+
+void LcmPipelineSink::publish(const FrameResult& r) {
+  const PlaceEstimate& e = r.estimate;
+  const std::int64_t now_us = monotonicMicroseconds();
+
+  for (const auto& [place, assignment] : r.finished_places) {
+    toposlam_lcm::place_event_t event{};
+    event.utime = now_us;
+    event.place = assignment.place;
+    event.node = assignment.node;
+    event.is_new = assignment.is_new;
+    event.probability = asFloat(assignment.probability);
+    event.first_frame = place.first_frame;
+    event.last_frame = place.last_frame;
+    event.representative_frame = place.representative_frame;
+    event.keypoints = place.keypoints;
+    event.thumbnail_width = place.thumbnail.cols;
+    event.thumbnail_height = place.thumbnail.rows;
+    jpeg_.clear();
+    if (!place.thumbnail.empty() && !cv::imencode(".jpg", place.thumbnail, jpeg_, jpeg_params_)) jpeg_.clear();
+    event.jpeg_size = static_cast<std::int32_t>(jpeg_.size());
+    event.jpeg.assign(jpeg_.begin(), jpeg_.end());
+    event.map_revision = e.map_revision;
+    send(channels_.place_event, buffer_.data(), encodeInto(event, buffer_));
+  }
+
+  if (r.topology) {
+    const TopologySnapshot& t = *r.topology;
+    toposlam_lcm::topology_t msg{};
+    msg.utime = now_us;
+    msg.map_revision = t.map_revision;
+    msg.probability = t.probability;
+    msg.particles = t.particles;
+    msg.current_node = e.node;
+    msg.num_nodes = static_cast<std::int32_t>(t.nodes.size());
+    // push_back rather than resize(): GCC 12 -O3 reports false null dereferences for resize here.
+    msg.nodes.reserve(t.nodes.size());
+    for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+      toposlam_lcm::topology_node_t n{};
+      n.id = t.nodes[i].id;
+      n.num_places = static_cast<std::int32_t>(t.nodes[i].places.size());
+      n.places = t.nodes[i].places;
+      n.num_representatives = static_cast<std::int32_t>(t.nodes[i].representative_frames.size());
+      n.representative_frames = t.nodes[i].representative_frames;
+      msg.nodes.push_back(std::move(n));
+    }
+    msg.num_edges = static_cast<std::int32_t>(t.edges.size());
+    msg.edges.reserve(t.edges.size());
+    for (const TopologyEdge& edge : t.edges) {
+      toposlam_lcm::topology_edge_t m{};
+      m.from = edge.from;
+      m.to = edge.to;
+      m.count = edge.count;
+      msg.edges.push_back(m);
+    }
+    send(channels_.topology, buffer_.data(), encodeInto(msg, buffer_));
+  }
+
+  if (r.has_frame) {
+    toposlam_lcm::place_t msg{};
+    msg.utime = toMicroseconds(r.source_time_s);
+    msg.frame = r.sequence;
+    msg.place = e.place;
+    msg.node = e.node;
+    msg.probability = asFloat(e.probability);
+    msg.is_new = e.is_new;
+    msg.lambda2 = asFloat(r.lambda2);
+    msg.num_alternatives = static_cast<std::int32_t>(e.alternatives.size());
+    msg.alternatives.reserve(e.alternatives.size());
+    for (const NodeProbability& alternative : e.alternatives) {
+      toposlam_lcm::place_alternative_t a{};
+      a.node = alternative.node;
+      a.probability = asFloat(alternative.probability);
+      msg.alternatives.push_back(a);
+    }
+    msg.map_revision = e.map_revision;
+    // Stamped last, just before publishing: the latency the message carries includes its own encoding.
+    msg.publish_utime = monotonicMicroseconds();
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    const double now_s = static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+    msg.latency_ms = asFloat((now_s - r.captured_at_s) * 1e3);
+    send(channels_.place, buffer_.data(), encodeInto(msg, buffer_));
+  }
+}
+
+void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
+  toposlam_lcm::status_t msg{};
+  msg.utime = monotonicMicroseconds();
+  msg.state = s.state;
+  msg.uptime_s = asFloat(s.uptime_s);
+  msg.fps = asFloat(s.fps);
+  msg.frames_captured = s.frames_captured;
+  msg.frames_published = s.frames_published;
+  msg.frames_dropped = s.frames_dropped;
+  msg.source_skipped = s.source_skipped;
+  msg.latency_median_ms = asFloat(s.latency.median_ms);
+  msg.latency_p99_ms = asFloat(s.latency.p99_ms);
+  msg.latency_max_ms = asFloat(s.latency.max_ms);
+  msg.cpu_percent = asFloat(s.cpu_percent);
+  msg.places = s.places;
+  msg.map_revision = s.map_revision;
+  msg.maps_saved = s.maps_saved;
+  msg.motion_messages = motion_messages_ ? motion_messages_->load() : 0;
+  msg.num_stages = static_cast<std::int32_t>(s.stages.size());
+  msg.stages.reserve(s.stages.size());
+  for (const StageStatus& st : s.stages) {
+    toposlam_lcm::stage_status_t m{};
+    m.name = st.name;
+    m.latency_median_ms = asFloat(st.latency.median_ms);
+    m.latency_p99_ms = asFloat(st.latency.p99_ms);
+    m.latency_max_ms = asFloat(st.latency.max_ms);
+    m.processed = st.processed;
+    m.dropped = st.dropped;
+    m.queue_depth = static_cast<std::int32_t>(st.queue_depth);
+    m.queue_capacity = static_cast<std::int32_t>(st.queue_capacity);
+    m.cpu_percent = asFloat(st.cpu_percent);
+    msg.stages.push_back(std::move(m));
+  }
+  send(channels_.status, buffer_.data(), encodeInto(msg, buffer_));
+}
+
+// --------------------------------------------------------------------------------------------------------
+
+namespace {
+
+void jsonNumber(JsonWriter& w, const char* key, float v) {
+  w.key(key);
+  if (std::isfinite(v))
+    w.value(static_cast<double>(v));
+  else
+    w.null();
+}
+
+template <typename Message>
+bool decodeMessage(const lcm::ReceiveBuffer* buffer, Message& msg) {
+  return msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0;
+}
+
+}  // namespace
+
+struct LcmSubscriber::Route {
+  LcmSubscriber* self;
+  std::string kind;
+};
+
+LcmSubscriber::LcmSubscriber(const std::string& url, const LcmChannels& known, const std::vector<std::string>& channels,
+                             Callback callback)
+    : lcm_(openLcm(url)), callback_(std::move(callback)) {
+  for (const std::string& channel : channels) {
+    std::string kind;
+    if (channel == known.place) kind = "place";
+    else if (channel == known.place_event) kind = "place_event";
+    else if (channel == known.topology) kind = "topology";
+    else if (channel == known.status) kind = "status";
+    else if (channel == known.motion) kind = "motion";
+    else
+      throw std::invalid_argument("unknown channel '" + channel + "': expected one of " + known.place + ", " +
+                                  known.place_event + ", " + known.topology + ", " + known.status + ", " + known.motion);
+    routes_.push_back(std::make_unique<Route>(Route{this, kind}));
+    lcm_->subscribeFunction(channel, &LcmSubscriber::dispatch, routes_.back().get());
+  }
+}
+
+LcmSubscriber::~LcmSubscriber() = default;
+
+bool LcmSubscriber::handle(int timeout_ms) { return lcm_->handleTimeout(timeout_ms) >= 0; }
+
+void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string& channel, Route* route) {
+  LcmSubscriber& self = *route->self;
+  ReceivedMessage out;
+  out.channel = channel;
+  out.kind = route->kind;
+  std::ostringstream json;
+  JsonWriter w(json, false);
+  w.beginObject().field("channel", channel).field("kind", route->kind);
+  bool ok = true;
+  if (route->kind == "place") {
+    toposlam_lcm::place_t m{};
+    ok = decodeMessage(buffer, m);
+    if (ok) {
+      out.frame = m.frame;
+      out.node = m.node;
+      out.place = m.place;
+      out.is_new = m.is_new;
+      w.field("utime", m.utime).field("frame", m.frame).field("place", m.place).field("node", m.node);
+      jsonNumber(w, "probability", m.probability);
+      w.field("is_new", m.is_new != 0);
+      jsonNumber(w, "lambda2", m.lambda2);
+      jsonNumber(w, "latency_ms", m.latency_ms);
+      w.key("alternatives").beginArray();
+      for (const auto& a : m.alternatives) {
+        w.beginObject().field("node", a.node);
+        jsonNumber(w, "probability", a.probability);
+        w.endObject();
+      }
+      w.endArray().field("map_revision", m.map_revision);
+      char line[256];
+      std::snprintf(line, sizeof line, "place  frame %6lld  place %3d  node %3d  p=%.2f%s  rev %lld  latency %.1f ms",
+                    static_cast<long long>(m.frame), m.place, m.node, static_cast<double>(m.probability),
+                    m.is_new ? " new" : "", static_cast<long long>(m.map_revision), static_cast<double>(m.latency_ms));
+      out.summary = line;
+    }
+  } else if (route->kind == "place_event") {
+    toposlam_lcm::place_event_t m{};
+    ok = decodeMessage(buffer, m);
+    if (ok) {
+      out.node = m.node;
+      out.place = m.place;
+      out.is_new = m.is_new;
+      w.field("place", m.place).field("node", m.node).field("is_new", m.is_new != 0);
+      jsonNumber(w, "probability", m.probability);
+      w.field("first_frame", m.first_frame).field("last_frame", m.last_frame)
+          .field("representative_frame", m.representative_frame).field("keypoints", m.keypoints)
+          .field("thumbnail_width", m.thumbnail_width).field("thumbnail_height", m.thumbnail_height)
+          .field("jpeg_bytes", m.jpeg_size).field("map_revision", m.map_revision);
+      char line[256];
+      std::snprintf(line, sizeof line, "EVENT  place %3d -> node %3d  %s  p=%.2f  frames %lld..%lld  representative %lld  jpeg %d bytes",
+                    m.place, m.node, m.is_new ? "new node" : "revisit ", static_cast<double>(m.probability),
+                    static_cast<long long>(m.first_frame), static_cast<long long>(m.last_frame),
+                    static_cast<long long>(m.representative_frame), m.jpeg_size);
+      out.summary = line;
+    }
+  } else if (route->kind == "topology") {
+    toposlam_lcm::topology_t m{};
+    ok = decodeMessage(buffer, m);
+    if (ok) {
+      out.node = m.current_node;
+      w.field("map_revision", m.map_revision).field("probability", m.probability).field("particles", m.particles)
+          .field("current_node", m.current_node);
+      w.key("nodes").beginArray();
+      for (const auto& n : m.nodes) {
+        w.beginObject().field("id", n.id).key("places").beginArray();
+        for (int p : n.places) w.value(p);
+        w.endArray().endObject();
+      }
+      w.endArray().key("edges").beginArray();
+      for (const auto& e : m.edges) w.beginObject().field("from", e.from).field("to", e.to).field("count", e.count).endObject();
+      w.endArray();
+      char line[160];
+      std::snprintf(line, sizeof line, "TOPOLOGY  rev %lld  %d nodes  %d edges  p=%.2f  current node %d",
+                    static_cast<long long>(m.map_revision), m.num_nodes, m.num_edges, m.probability, m.current_node);
+      out.summary = line;
+    }
+  } else if (route->kind == "status") {
+    toposlam_lcm::status_t m{};
+    ok = decodeMessage(buffer, m);
+    if (ok) {
+      w.field("state", m.state);
+      jsonNumber(w, "fps", m.fps);
+      w.field("frames_captured", m.frames_captured).field("frames_published", m.frames_published)
+          .field("frames_dropped", m.frames_dropped);
+      jsonNumber(w, "latency_median_ms", m.latency_median_ms);
+      jsonNumber(w, "latency_p99_ms", m.latency_p99_ms);
+      jsonNumber(w, "latency_max_ms", m.latency_max_ms);
+      jsonNumber(w, "cpu_percent", m.cpu_percent);
+      w.field("places", m.places).field("map_revision", m.map_revision).field("maps_saved", m.maps_saved)
+          .field("motion_messages", m.motion_messages);
+      w.key("stages").beginArray();
+      for (const auto& st : m.stages) {
+        w.beginObject().field("name", st.name);
+        jsonNumber(w, "latency_median_ms", st.latency_median_ms);
+        jsonNumber(w, "latency_max_ms", st.latency_max_ms);
+        w.field("processed", st.processed).field("dropped", st.dropped).field("queue_depth", st.queue_depth);
+        jsonNumber(w, "cpu_percent", st.cpu_percent);
+        w.endObject();
+      }
+      w.endArray();
+      char line[200];
+      std::snprintf(line, sizeof line, "STATUS %s  %.1f fps  latency median %.1f / p99 %.1f ms  %lld published  %lld dropped  cpu %.0f%%",
+                    m.state.c_str(), static_cast<double>(m.fps), static_cast<double>(m.latency_median_ms),
+                    static_cast<double>(m.latency_p99_ms), static_cast<long long>(m.frames_published),
+                    static_cast<long long>(m.frames_dropped), static_cast<double>(m.cpu_percent));
+      out.summary = line;
+    }
+  } else {
+    toposlam_lcm::motion_t m{};
+    ok = decodeMessage(buffer, m);
+    if (ok) {
+      w.field("utime", m.utime).field("sequence", m.sequence).field("forward_m", m.forward_m)
+          .field("turn_rad", m.turn_rad).field("moving", m.moving != 0);
+      char line[160];
+      std::snprintf(line, sizeof line, "MOTION #%lld  forward %.3f m  turn %.3f rad", static_cast<long long>(m.sequence),
+                    m.forward_m, m.turn_rad);
+      out.summary = line;
+    }
+  }
+  if (!ok) {
+    self.malformed_.fetch_add(1);
+    return;
+  }
+  w.endObject();
+  out.json = json.str();
+  self.received_.fetch_add(1);
+  if (self.callback_) self.callback_(out);
+}
+
+}  // namespace toposlam

@@ -1,0 +1,16 @@
+// Plugs `v4l2:` into the frame-source factory (openFrameSource), so every app opens cameras by URI.
+#include "toposlam/io/source_factory.hpp"
+#include "toposlam/io/v4l2_frame_source.hpp"
+
+namespace toposlam {
+
+void registerV4l2FrameSourceScheme() {
+  registerFrameSourceScheme(
+      "v4l2",
+      [](const SourceUri& uri) -> std::unique_ptr<FrameSource> {
+        return std::make_unique<V4l2FrameSource>(parseV4l2Uri(uri.text));
+      },
+      "v4l2:/dev/videoN?size=WxH&fps=F&format=yuyv|mjpeg|grey|bgr24|rgb24&buffers=N");
+}
+
+}  // namespace toposlam

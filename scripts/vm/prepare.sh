@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Prepares everything the VM test boots, cached in CACHE_DIR so reruns take a second:
+#   - Debian's own kernel (the ABI linux-image-amd64 depends on), downloaded with `apt-get download`,
+#     unpacked privately (nothing is installed on the host);
+#   - v4l2loopback.ko, built from Debian's v4l2loopback-dkms source against that kernel's headers,
+#     which are also only unpacked into the cache (their Makefile is pointed at the private copy);
+#   - the kernel modules the guest needs (videodev, vivid, 9p over virtio) with their dependencies,
+#     in load order, listed in CACHE_DIR/mods/order.
+# Usage: scripts/vm/prepare.sh CACHE_DIR        Prints the kernel release on success.
+# Needs: apt-get (download only), dpkg-deb, make, gcc, kmod (modprobe/depmod). No root needed except
+# for apt-get's download cache permissions on some systems.
+set -euo pipefail
+
+cache=${1:?usage: prepare.sh CACHE_DIR}
+mkdir -p "$cache"
+cache=$(cd "$cache" && pwd)
+stamp="$cache/prepared.stamp"
+if [ -f "$stamp" ] && [ -f "$cache/vmlinuz" ] && [ -f "$cache/mods/order" ]; then
+  cat "$stamp"
+  exit 0
+fi
+
+log() { echo "vm-prepare: $*" >&2; }
+
+kpkg=$(apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-/{print $2; exit}')
+[ -n "$kpkg" ] || { log "cannot find the kernel package linux-image-amd64 depends on (apt-get update?)"; exit 1; }
+kver=${kpkg#linux-image-}
+kbuild="linux-kbuild-$(echo "$kver" | cut -d. -f1,2)"
+log "kernel $kver"
+
+debs="$cache/debs"
+mkdir -p "$debs"
+(
+  cd "$debs"
+  for p in "$kpkg" "linux-headers-$kver" "linux-headers-${kver%-amd64}-common" "$kbuild" v4l2loopback-dkms; do
+    ls "${p}"_*.deb >/dev/null 2>&1 || apt-get download "$p" >&2 2>/dev/null || apt-get download "$p" >&2
+  done
+)
+
+root="$cache/root"
+rm -rf "$root" && mkdir -p "$root"
+for d in "$debs"/*.deb; do dpkg-deb -x "$d" "$root"; done
+
+# The headers' Makefile includes the common tree by absolute path: point it at our private copy.
+hdr="$root/usr/src/linux-headers-$kver"
+sed -i "s|/usr/src/|$root/usr/src/|g" "$hdr/Makefile"
+lbsrc=$(echo "$root"/usr/src/v4l2loopback-*)
+log "building v4l2loopback.ko from $(basename "$lbsrc")"
+make -s -C "$hdr" M="$lbsrc" modules >"$cache/v4l2loopback-build.log" 2>&1 || {
+  cat "$cache/v4l2loopback-build.log" >&2; log "module build failed"; exit 1; }
+
+depmod -b "$root" "$kver"
+mods="$cache/mods"
+rm -rf "$mods" && mkdir -p "$mods"
+: >"$mods/order"
+for m in virtio_pci 9pnet_virtio 9p videodev vivid; do
+  for f in $(modprobe -d "$root" -S "$kver" --show-depends "$m" | awk '$1=="insmod"{print $2}'); do
+    b=$(basename "$f")
+    if ! grep -qx "$b" "$mods/order"; then
+      cp "$f" "$mods/"
+      echo "$b" >>"$mods/order"
+    fi
+  done
+done
+cp "$lbsrc/v4l2loopback.ko" "$mods/" && echo v4l2loopback.ko >>"$mods/order"
+cp "$root/boot/vmlinuz-$kver" "$cache/vmlinuz"
+# The unpacked headers and kernel modules are large and no longer needed.
+rm -rf "$root"
+echo "$kver" >"$stamp"
+cat "$stamp"

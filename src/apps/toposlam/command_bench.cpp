@@ -1,0 +1,84 @@
+// `toposlam bench ...`: benchmarks that print numbers (median and p99 ms, rates) and fail nothing.
+// Each module adds its own sub-benchmark; this file holds the group and the fingerprint benchmark.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include <opencv2/core/utility.hpp>
+
+#include "bench_stats.hpp"
+#include "commands.hpp"
+#include "sample_frames.hpp"
+#include "toposlam/core/worker_pool.hpp"
+#include "toposlam/fingerprint/vpack_extractor.hpp"
+
+namespace toposlam::cli {
+
+namespace {
+
+struct FingerprintBenchOptions {
+  std::string samples;
+  int repeat = 3;
+  std::vector<std::string> backends = {"orb", "sift"};
+  std::vector<int> workers = {1, 2};
+};
+
+void runFingerprintBench(const FingerprintBenchOptions& o) {
+  cv::setNumThreads(1);  // measure our own parallelism, not OpenCV's
+  std::cout << "VPACK extraction, " << o.repeat << " passes over the sample frames (" << o.samples << ")\n";
+  std::cout << std::left << std::setw(10) << "size" << std::setw(8) << "kp" << std::setw(9) << "workers"
+            << std::right << std::setw(12) << "median ms" << std::setw(10) << "p99 ms" << std::setw(10) << "fps"
+            << std::setw(12) << "keypoints" << std::setw(9) << "edges" << "\n";
+  for (cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
+    const std::vector<cv::Mat> frames = loadSampleFrames(o.samples, size);
+    for (const std::string& backend : o.backends) {
+      for (int workers : o.workers) {
+        VpackConfig config;
+        config.keypoints.backend = parseKeypointBackend(backend);
+        WorkerPool pool(workers, "bench");
+        VpackExtractor extractor(config, &pool);
+        std::vector<double> ms;
+        double keypoints = 0, edges = 0;
+        for (int pass = 0; pass < o.repeat; ++pass) {
+          for (const cv::Mat& frame : frames) {
+            Stopwatch watch;
+            Fingerprint f = extractor.extract(frame);
+            ms.push_back(watch.elapsedMs());
+            keypoints += f.keypointCount();
+            edges += static_cast<double>(f.edge_columns.size());
+          }
+        }
+        const TimingSummary s = summarize(ms);
+        std::cout << std::left << std::setw(10) << (std::to_string(size.width) + "x" + std::to_string(size.height))
+                  << std::setw(8) << backend << std::setw(9) << workers << std::right << std::fixed
+                  << std::setprecision(2) << std::setw(12) << s.median_ms << std::setw(10) << s.p99_ms
+                  << std::setw(10) << std::setprecision(1) << 1000.0 / s.median_ms << std::setw(12)
+                  << keypoints / ms.size() << std::setw(9) << edges / ms.size() << "\n";
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void addBenchFingerprint(CLI::App& bench) {
+  auto options = std::make_shared<FingerprintBenchOptions>();
+  options->samples = defaultSamplesFolder();
+  auto* cmd = bench.add_subcommand("fingerprint", "ms per frame of VPACK extraction (320x240, 640x480)");
+  cmd->add_option("--samples", options->samples, "Folder of frames")->capture_default_str();
+  cmd->add_option("--repeat", options->repeat, "Passes over the frames")->check(CLI::Range(1, 1000));
+  cmd->add_option("--keypoints", options->backends, "Backends to measure")->capture_default_str();
+  cmd->add_option("--workers", options->workers, "Worker counts to measure")->capture_default_str();
+  cmd->callback([options] { runFingerprintBench(*options); });
+}
+
+void addBenchCommand(CLI::App& app) {
+  auto* bench = app.add_subcommand("bench", "Benchmarks: print timings, fail nothing");
+  bench->require_subcommand(1);
+  addBenchFingerprint(*bench);
+  addBenchTopology(*bench);
+  addBenchSegmentation(*bench);
+  addBenchSim(*bench);
+}
+
+}  // namespace toposlam::cli

@@ -1,0 +1,184 @@
+// `toposlam capture URI --count N`: reads frames from a camera (v4l2:/dev/videoN?..., libcamera:ID) and
+// prints one line per frame (sequence, timestamp, size) and a summary (frames, drops, skips, reconnects,
+// rate, and the age of each frame when it came out of the source: now on CLOCK_MONOTONIC minus the
+// driver's buffer timestamp, i.e. driver-to-application latency, meaningful when the driver stamps
+// buffers with the monotonic clock as V4L2 drivers normally do). It is how the VM test and users check that a
+// camera works before running the daemon. Registering this command also registers the `v4l2:` and
+// `libcamera:` schemes with openFrameSource().
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "commands.hpp"
+#include "toposlam/io/v4l2_frame_source.hpp"
+#ifdef TOPOSLAM_HAVE_LIBCAMERA
+#include "toposlam/io/libcamera_frame_source.hpp"
+#endif
+
+namespace toposlam::cli {
+
+namespace {
+
+struct CaptureOptions {
+  std::string uri;
+  int count = 30;
+  double timeout_s = 0.0;
+  int hold = 0;
+  bool quiet = false;
+};
+
+/// Calls `stop` after `seconds` unless cancelled first (destruction cancels).
+class StopTimer {
+ public:
+  StopTimer(double seconds, std::function<void()> stop) {
+    if (seconds <= 0.0) return;
+    thread_ = std::thread([this, seconds, stop = std::move(stop)] {
+      std::unique_lock lock(mutex_);
+      if (!cv_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return cancelled_; })) stop();
+    });
+  }
+  ~StopTimer() {
+    {
+      std::lock_guard lock(mutex_);
+      cancelled_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  StopTimer(const StopTimer&) = delete;
+  StopTimer& operator=(const StopTimer&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool cancelled_ = false;
+  std::thread thread_;
+};
+
+void runCapture(const CaptureOptions& options) {
+  std::unique_ptr<FrameSource> source;
+  std::function<void()> request_stop;
+  std::function<std::int64_t()> reconnects = [] { return std::int64_t{0}; };
+  std::function<std::int64_t()> dropped = [] { return std::int64_t{0}; };
+  if (options.uri.rfind("v4l2:", 0) == 0) {
+    auto v4l2 = std::make_unique<V4l2FrameSource>(parseV4l2Uri(options.uri));
+    V4l2FrameSource* raw = v4l2.get();
+    request_stop = [raw] { raw->requestStop(); };
+    reconnects = [raw] { return raw->status().reconnects; };
+    dropped = [raw] { return raw->droppedFrames(); };
+    source = std::move(v4l2);
+  } else if (options.uri.rfind("libcamera:", 0) == 0) {
+#ifdef TOPOSLAM_HAVE_LIBCAMERA
+    auto camera = std::make_unique<LibcameraFrameSource>(parseLibcameraUri(options.uri));
+    LibcameraFrameSource* raw = camera.get();
+    request_stop = [raw] { raw->requestStop(); };
+    dropped = [raw] { return raw->droppedFrames(); };
+    source = std::move(camera);
+#else
+    throw std::runtime_error("this toposlam was built without libcamera (install libcamera-dev and rebuild)");
+#endif
+  } else {
+    throw std::runtime_error(
+        "capture reads cameras: expected v4l2:/dev/videoN?size=WxH&fps=F&format=F or "
+        "libcamera:ID, got '" +
+        options.uri + "'");
+  }
+  std::printf("source %s\n", source->describe().c_str());
+  std::fflush(stdout);
+
+  StopTimer timer(options.timeout_s, request_stop);
+  std::vector<Frame> held;  // simulates a slow consumer holding zero-copy buffers
+  int frames = 0;
+  double first_t = 0.0;
+  double last_t = 0.0;
+  std::int64_t seen_reconnects = 0;
+  std::vector<double> ages_ms;
+  const auto started = std::chrono::steady_clock::now();
+  while (options.count <= 0 || frames < options.count) {
+    std::optional<Frame> frame = source->next();
+    if (!frame) break;
+    if (frames == 0) first_t = frame->timestamp_s;
+    last_t = frame->timestamp_s;
+    ++frames;
+    const double age_ms =
+        1e3 * (std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() -
+               frame->timestamp_s);
+    ages_ms.push_back(age_ms);
+    if (const std::int64_t now = reconnects(); now != seen_reconnects) {
+      std::printf("event reconnected reconnects=%lld\n", static_cast<long long>(now));
+      seen_reconnects = now;
+    }
+    if (!options.quiet) {
+      std::printf("frame seq=%lld t=%.6f size=%dx%d zero_copy=%d age_ms=%.2f\n",
+                  static_cast<long long>(frame->sequence), frame->timestamp_s, frame->image.cols,
+                  frame->image.rows, frame->buffer_lease ? 1 : 0, age_ms);
+      std::fflush(stdout);
+    }
+    if (options.hold > 0) {
+      held.push_back(std::move(*frame));
+      if (static_cast<int>(held.size()) > options.hold) held.erase(held.begin());
+    }
+  }
+  held.clear();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const double span_s = last_t - first_t;
+  std::sort(ages_ms.begin(), ages_ms.end());
+  auto quantile = [&](double q) {
+    return ages_ms.empty()
+               ? 0.0
+               : ages_ms[static_cast<std::size_t>(q * static_cast<double>(ages_ms.size() - 1) + 0.5)];
+  };
+  std::printf(
+      "summary frames=%d dropped=%lld skipped=%lld reconnects=%lld seconds=%.3f fps=%.2f "
+      "age_ms_median=%.2f age_ms_p99=%.2f\n",
+      frames, static_cast<long long>(dropped()), static_cast<long long>(source->skippedFrames()),
+      static_cast<long long>(reconnects()), wall_s, frames > 1 && span_s > 0 ? (frames - 1) / span_s : 0.0,
+      quantile(0.5), quantile(0.99));
+  std::fflush(stdout);
+  if (options.count > 0 && frames < options.count)
+    throw std::runtime_error("capture: only " + std::to_string(frames) + " of " +
+                             std::to_string(options.count) + " frames within " +
+                             std::to_string(options.timeout_s) + " s");
+}
+
+}  // namespace
+
+void addCaptureCommand(CLI::App& app) {
+  // Cameras become openable by URI (openFrameSource) for every other command too.
+  registerV4l2FrameSourceScheme();
+#ifdef TOPOSLAM_HAVE_LIBCAMERA
+  registerLibcameraFrameSourceScheme();
+#endif
+  auto options = std::make_shared<CaptureOptions>();
+  CLI::App* command = app.add_subcommand("capture",
+                                         "Read frames from a camera and print their sequence numbers "
+                                         "and timestamps (checks a camera before running the daemon)");
+  command
+      ->add_option("uri", options->uri,
+                   "camera: v4l2:/dev/video0?size=640x480&fps=30&format=yuyv|mjpeg|grey|"
+                   "bgr24|rgb24 or libcamera:ID")
+      ->required();
+  command->add_option("--count,-n", options->count, "frames to read; 0 = until --timeout")
+      ->check(CLI::NonNegativeNumber);
+  command
+      ->add_option("--timeout", options->timeout_s,
+                   "stop after this many seconds (0 = never); fewer frames than "
+                   "--count is then an error")
+      ->check(CLI::NonNegativeNumber);
+  command
+      ->add_option("--hold", options->hold,
+                   "keep the last N frames alive (a slow consumer of zero-copy buffers)")
+      ->check(CLI::Range(0, 64));
+  command->add_flag("--quiet,-q", options->quiet, "print the summary only");
+  command->callback([options] { runCapture(*options); });
+}
+
+}  // namespace toposlam::cli

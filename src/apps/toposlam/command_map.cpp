@@ -1,0 +1,419 @@
+// `toposlam map SOURCE... --out DIR`: offline topological SLAM. Each source's frames go through VPACK
+// (chapter 3) and the Fiedler segmenter (chapter 4); every kept place's representative is one step of the
+// topology particle filter (chapter 5). Several sources are processed one after another as consecutive
+// traversals (the thesis stacks two runs); each source gets a fresh segmentation window, the filter
+// carries on. --resume MAP continues a saved map (its filter config and random state come from the file).
+//
+// Writes the run folder of docs/run-folder.md: frames.csv, places.csv, dropped_places.csv,
+// topology.json, topology.dot (+ .svg/.png when Graphviz' `dot` is installed), timing.csv, lambda2.svg
+// and map.tsm. Frames and places are numbered from 0 over all sources of this run, in stream order; with
+// --resume, the resumed map's places appear in topology.json as `earlier_places` (filter observation
+// numbers). The map's application data keeps, per observation, the run and frame it came from.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "toposlam/core/json_writer.hpp"
+#include "toposlam/core/svg_plot.hpp"
+#include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/io/frame_source.hpp"
+#include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/topology/map_store.hpp"
+#include "toposlam/topology/topology_particle_filter.hpp"
+
+#ifdef TOPOSLAM_HAVE_SOURCES
+#include "toposlam/io/source_factory.hpp"
+#endif
+
+namespace toposlam::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct MapOptions {
+  std::vector<std::string> sources;
+  std::string out;
+  int particles = 500;
+  double alpha = 15.0;
+  std::uint64_t seed = 1;
+  int max_representatives = 8;
+  std::string resume;
+  std::string keypoints = "orb";
+};
+
+std::unique_ptr<FrameSource> openSource(const std::string& uri) {
+#ifdef TOPOSLAM_HAVE_SOURCES
+  return openFrameSource(uri);
+#else
+  throw FrameSourceError("cannot open '" + uri +
+                         "': this build has no frame sources (toposlam_sources was not "
+                         "built; see io/source_factory.hpp)");
+#endif
+}
+
+/// Per observation of the map (this run's and earlier runs'): where it came from.
+struct ObservationOrigin {
+  int run = 0;                             ///< 0 for the first `map` run, +1 per --resume
+  std::int64_t representative_frame = -1;  ///< frame number within that run
+};
+
+std::string encodeOrigins(const std::vector<ObservationOrigin>& origins) {
+  std::ostringstream out;
+  out << "toposlam-map-origins 1\n";
+  for (const auto& o : origins) out << o.run << ' ' << o.representative_frame << '\n';
+  return out.str();
+}
+
+std::vector<ObservationOrigin> decodeOrigins(const std::string& text, int observations) {
+  std::istringstream in(text);
+  std::string magic;
+  int version = 0;
+  std::vector<ObservationOrigin> origins;
+  if (in >> magic >> version && magic == "toposlam-map-origins" && version == 1) {
+    ObservationOrigin o;
+    while (in >> o.run >> o.representative_frame) origins.push_back(o);
+  }
+  // A map written by another tool: unknown origins.
+  origins.resize(static_cast<std::size_t>(observations), ObservationOrigin{-1, -1});
+  return origins;
+}
+
+struct StepRow {
+  std::int64_t place = 0;  ///< kept place of this run
+  TopologyEstimate estimate;
+};
+
+struct FrameTiming {
+  double fingerprint_ms = 0.0, segment_ms = 0.0, filter_ms = 0.0;
+};
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string shellQuote(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::ofstream openOutput(const fs::path& path) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw std::runtime_error(path.string() + ": cannot create file (is the folder writable?)");
+  return out;
+}
+
+/// Appends one source's segmentation to the run of all sources, renumbering frames and places.
+void appendRun(SegmentationRun& all, const SegmentationRun& part) {
+  const auto frame_offset = static_cast<std::int64_t>(all.frames.size());
+  const auto kept_offset = static_cast<std::int64_t>(all.places.size());
+  const auto dropped_offset = static_cast<std::int64_t>(all.dropped_places.size());
+  for (SegmentationFrameRecord f : part.frames) {
+    f.frame += frame_offset;
+    if (f.place >= 0) f.place += kept_offset;
+    all.frames.push_back(std::move(f));
+  }
+  auto shift = [&](SegmentedPlace p, std::int64_t index_offset) {
+    p.first_frame += frame_offset;
+    p.last_frame += frame_offset;
+    p.representative_frame += frame_offset;
+    if (p.valley_frame >= 0) p.valley_frame += frame_offset;
+    p.index += index_offset;
+    p.representative.reset();  // the filter keeps what it needs
+    return p;
+  };
+  for (const SegmentedPlace& p : part.places) all.places.push_back(shift(p, kept_offset));
+  for (const SegmentedPlace& p : part.dropped_places) all.dropped_places.push_back(shift(p, dropped_offset));
+}
+
+void runMap(const MapOptions& o, bool filter_options_given) {
+  if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
+  const fs::path out_dir(o.out);
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (!fs::is_directory(out_dir)) throw std::runtime_error(o.out + ": cannot create the output folder");
+
+  VpackConfig vpack;
+  vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
+  const VpackExtractor extractor(vpack);
+  const NgramSimilarity similarity;
+  const FiedlerSegmenterConfig segmenter_config;
+
+  std::unique_ptr<TopologyParticleFilter> filter;
+  std::vector<ObservationOrigin> origins;
+  int run_number = 0;
+  if (!o.resume.empty()) {
+    if (filter_options_given) {
+      throw std::invalid_argument(
+          "map: --particles, --alpha, --seed and --max-representatives come from the map "
+          "when resuming; drop them or start a new map");
+    }
+    LoadedMap loaded = MapStore::load(o.resume, similarity);
+    filter = std::move(loaded.filter);
+    origins = decodeOrigins(loaded.application_data, filter->observationCount());
+    for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
+    std::cerr << "map: resumed " << o.resume << " (" << filter->observationCount() << " places)\n";
+  } else {
+    TopologyFilterConfig config;
+    config.particles = o.particles;
+    config.alpha = o.alpha;
+    config.seed = o.seed;
+    config.max_representatives_per_node = o.max_representatives;
+    if (const std::string problem = config.validate(); !problem.empty())
+      throw std::invalid_argument("map: " + problem);
+    filter = std::make_unique<TopologyParticleFilter>(config, similarity);
+  }
+  const int first_observation = filter->observationCount();
+
+  SegmentationRun all;
+  std::vector<FrameTiming> timing;
+  std::vector<StepRow> steps;
+  std::int64_t refused = 0;
+
+  for (const std::string& uri : o.sources) {
+    std::unique_ptr<FrameSource> source = openSource(uri);
+    std::cerr << "map: " << source->describe() << "\n";
+    OfflineSegmentation pipeline(extractor, similarity, segmenter_config);  // fresh window per traversal
+    const auto kept_offset = static_cast<std::int64_t>(all.places.size());
+    const auto frame_offset = static_cast<std::int64_t>(all.frames.size());
+
+    auto mapPlace = [&](const SegmentedPlace& place) {
+      if (place.dropped) return;
+      const auto start = std::chrono::steady_clock::now();
+      filter->step(place.representative);
+      if (!timing.empty()) timing.back().filter_ms += msSince(start);
+      origins.push_back(ObservationOrigin{run_number, frame_offset + place.representative_frame});
+      steps.push_back(StepRow{kept_offset + place.index, filter->estimate(3)});
+      const TopologyEstimate& e = steps.back().estimate;
+      std::fprintf(stderr,
+                   "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
+                   static_cast<long long>(kept_offset + place.index),
+                   static_cast<long long>(frame_offset + place.first_frame),
+                   static_cast<long long>(frame_offset + place.last_frame), e.current_node,
+                   e.current_node_probability, e.best.probability, e.effective_sample_size);
+    };
+
+    while (std::optional<Frame> frame = source->next()) {
+      FrameTiming t;
+      auto start = std::chrono::steady_clock::now();
+      std::shared_ptr<const Fingerprint> fingerprint;
+      try {
+        fingerprint = pipeline.fingerprint(frame->image);
+      } catch (const std::invalid_argument& e) {
+        // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
+        if (refused++ == 0) std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
+        continue;
+      }
+      t.fingerprint_ms = msSince(start);
+      start = std::chrono::steady_clock::now();
+      const SegmenterStep step = pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
+      t.segment_ms = msSince(start);
+      timing.push_back(t);
+      frame.reset();  // hand the buffer back to the source
+      if (step.closed_place) mapPlace(*step.closed_place);
+    }
+    if (auto last = pipeline.finish()) mapPlace(*last);
+    if (source->skippedFrames() > 0)
+      std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
+    appendRun(all, pipeline.run());
+  }
+  if (all.frames.empty())
+    throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
+                             " refused)");
+
+  // The most probable topology decides every place's node.
+  const TopologyEstimate final_estimate = filter->estimate(3);
+  const std::vector<int>& assignment = final_estimate.best.assignment;
+  std::vector<std::int64_t> place_nodes;
+  for (std::size_t p = 0; p < all.places.size(); ++p) {
+    place_nodes.push_back(assignment[static_cast<std::size_t>(first_observation) + p]);
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "frames.csv");
+    writeFramesCsv(out, all, place_nodes);
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "places.csv");
+    writePlacesCsv(out, all.places, place_nodes);
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "dropped_places.csv");
+    writePlacesCsv(out, all.dropped_places);
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "timing.csv");
+    out << "frame,fingerprint_ms,segment_ms,filter_ms\n";
+    for (std::size_t i = 0; i < timing.size(); ++i) {
+      char line[112];
+      std::snprintf(line, sizeof(line), "%zu,%.4f,%.4f,%.4f\n", i, timing[i].fingerprint_ms,
+                    timing[i].segment_ms, timing[i].filter_ms);
+      out << line;
+    }
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "lambda2.svg");
+    out << renderSvgLinePlot(lambda2Plot(
+        all, segmenter_config, "Fiedler value over " + std::to_string(o.sources.size()) + " source(s)"));
+  }
+
+  // Nodes and edges of the best topology (over all observations, resumed ones included).
+  struct NodeInfo {
+    std::vector<std::int64_t> places, representative_frames, earlier_places;
+  };
+  std::map<int, NodeInfo> nodes;
+  for (std::size_t k = 0; k < assignment.size(); ++k) {
+    NodeInfo& n = nodes[assignment[k]];
+    if (static_cast<int>(k) < first_observation) {
+      n.earlier_places.push_back(static_cast<std::int64_t>(k));
+    } else {
+      const std::size_t p = k - static_cast<std::size_t>(first_observation);
+      n.places.push_back(static_cast<std::int64_t>(p));
+      n.representative_frames.push_back(all.places[p].representative_frame);
+    }
+  }
+  std::map<std::pair<int, int>, int> edges;
+  for (std::size_t k = 1; k < assignment.size(); ++k) {
+    if (assignment[k] != assignment[k - 1]) ++edges[{assignment[k - 1], assignment[k]}];
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "topology.json");
+    JsonWriter json(out);
+    json.beginObject();
+    json.field("probability", final_estimate.best.probability);
+    json.field("particles", filter->config().particles);
+    json.field("current_node", final_estimate.current_node);
+    json.field("current_node_probability", final_estimate.current_node_probability);
+    json.field("effective_sample_size", final_estimate.effective_sample_size);
+    json.field("distinct_topologies", final_estimate.distinct_topologies);
+    json.field("earlier_places", first_observation);
+    json.key("nodes").beginArray();
+    for (const auto& [node, info] : nodes) {
+      json.beginObject().field("id", node);
+      json.key("places").beginArray();
+      for (std::int64_t p : info.places) json.value(p);
+      json.endArray();
+      json.key("representative_frames").beginArray();
+      for (std::int64_t f : info.representative_frames) json.value(f);
+      json.endArray();
+      if (!info.earlier_places.empty()) {
+        json.key("earlier_places").beginArray();  // observations of the resumed map, before this run
+        for (std::int64_t p : info.earlier_places) json.value(p);
+        json.endArray();
+      }
+      json.endObject();
+    }
+    json.endArray();
+    json.key("edges").beginArray();
+    for (const auto& [edge, count] : edges) {
+      json.beginObject().field("from", edge.first).field("to", edge.second).field("count", count).endObject();
+    }
+    json.endArray();
+    json.key("alternatives").beginArray();
+    for (const TopologyHypothesis& h : final_estimate.alternatives) {
+      json.beginObject().field("probability", h.probability).field("nodes", h.node_count);
+      json.field("first_difference", h.first_difference).endObject();  // observation number
+    }
+    json.endArray();
+    json.key("history").beginArray();
+    for (const StepRow& s : steps) {
+      json.beginObject()
+          .field("place", s.place)
+          .field("node", s.estimate.current_node)
+          .field("probability", s.estimate.current_node_probability)
+          .field("best_topology_probability", s.estimate.best.probability)
+          .field("effective_sample_size", s.estimate.effective_sample_size)
+          .endObject();
+    }
+    json.endArray();
+    json.endObject();
+    out << "\n";
+  }
+  {
+    std::ostringstream dot;
+    dot << "digraph topology {\n  graph [label=\"most probable topology, p = " << std::setprecision(3)
+        << final_estimate.best.probability << "\", labelloc=t];\n  node [shape=circle, style=filled, "
+        << "fillcolor=\"#dde8f5\", fontname=\"Helvetica\"];\n  edge [fontname=\"Helvetica\", fontsize=10];\n";
+    for (const auto& [node, info] : nodes) {
+      dot << "  n" << node << " [label=\"" << node << "\\nplaces";
+      for (std::size_t i = 0; i < info.places.size(); ++i) dot << (i == 0 ? " " : ",") << info.places[i];
+      if (!info.earlier_places.empty()) dot << "\\n(+" << info.earlier_places.size() << " earlier)";
+      dot << "\"" << (node == final_estimate.current_node ? ", fillcolor=\"#f5c542\"" : "") << "];\n";
+    }
+    for (const auto& [edge, count] : edges) {
+      dot << "  n" << edge.first << " -> n" << edge.second << " [label=\"" << count << "\"];\n";
+    }
+    dot << "}\n";
+    {
+      std::ofstream out = openOutput(out_dir / "topology.dot");
+      out << dot.str();
+    }
+    if (std::system("command -v dot >/dev/null 2>&1") == 0) {
+      const std::string dot_path = shellQuote((out_dir / "topology.dot").string());
+      for (const char* format : {"svg", "png"}) {
+        const std::string command = std::string("dot -T") + format + " " + dot_path + " -o " +
+                                    shellQuote((out_dir / (std::string("topology.") + format)).string());
+        if (std::system(command.c_str()) != 0) std::cerr << "map: warning: `" << command << "` failed\n";
+      }
+    } else {
+      std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
+    }
+  }
+  MapStore::save(out_dir / "map.tsm", *filter, encodeOrigins(origins));
+
+  std::printf(
+      "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "
+      "p = %.3f; wrote %s\n",
+      all.frames.size(), all.places.size(), all.dropped_places.size(), nodes.size(),
+      final_estimate.best.probability, final_estimate.current_node, final_estimate.current_node_probability,
+      out_dir.string().c_str());
+}
+
+}  // namespace
+
+void addMapCommand(CLI::App& app) {
+  auto options = std::make_shared<MapOptions>();
+  auto* cmd = app.add_subcommand(
+      "map", "Offline topological SLAM: segmentation plus the particle filter over topologies");
+  cmd->add_option("sources", options->sources,
+                  "Frame sources (images:DIR, video:FILE, sim:..., or a folder), "
+                  "processed one after another as consecutive traversals")
+      ->required();
+  cmd->add_option("--out", options->out, "Output run folder")->required();
+  auto* particles = cmd->add_option("--particles", options->particles, "Particles (thesis: 500)")
+                        ->check(CLI::Range(1, 1000000))
+                        ->capture_default_str();
+  auto* alpha = cmd->add_option("--alpha", options->alpha, "Prior map size of eq. 5.8 (thesis: 15)")
+                    ->capture_default_str();
+  auto* seed = cmd->add_option("--seed", options->seed, "Seed of the filter's random generator")
+                   ->capture_default_str();
+  auto* reps = cmd->add_option("--max-representatives", options->max_representatives,
+                               "Representatives kept per node (oldest dropped)")
+                   ->check(CLI::Range(1, kTopologyMaxRepresentatives))
+                   ->capture_default_str();
+  cmd->add_option("--resume", options->resume, "Continue the map in this map.tsm");
+  cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
+      ->capture_default_str();
+  cmd->callback([options, particles, alpha, seed, reps] {
+    const bool filter_options_given = particles->count() + alpha->count() + seed->count() + reps->count() > 0;
+    runMap(*options, filter_options_given);
+  });
+}
+
+}  // namespace toposlam::cli

@@ -1,0 +1,178 @@
+// `toposlam report RUN_DIR [--truth ...] [--frames DIR]... [--out report.html]`: one self-contained HTML
+// page for a run folder (see include/toposlam/eval/report.hpp for the figures). Thumbnails come from the
+// run's frames: `--frames DIR` (one per traversal, in order), else RUN_DIR/frames/, else the folders
+// listed in RUN_DIR/source.txt (one source URI per line; `images:DIR` or a plain folder). A frame is
+// found by its frames.csv `name` in its traversal's folder, else by its position in that folder.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "commands.hpp"
+#include "toposlam/core/natural_order.hpp"
+#include "toposlam/eval/report.hpp"
+
+namespace toposlam::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ReportCommandOptions {
+  std::string run_dir;
+  std::vector<std::string> truth;
+  std::vector<std::string> frames;
+  std::string out;
+  std::string figures;
+  std::string title;
+  eval::EvalOptions eval;
+  int thumbnails = 96;
+};
+
+std::vector<fs::path> frameFolders(const ReportCommandOptions& o, std::vector<std::string>& warnings) {
+  std::vector<fs::path> folders;
+  for (const auto& f : o.frames) {
+    if (!fs::is_directory(f)) throw std::invalid_argument("--frames: '" + f + "' is not a folder");
+    folders.emplace_back(f);
+  }
+  if (!folders.empty()) return folders;
+  const fs::path run(o.run_dir);
+  if (fs::is_directory(run / "frames")) return {run / "frames"};
+  std::ifstream sources(run / "source.txt");
+  std::string line;
+  while (std::getline(sources, line)) {
+    if (line.empty()) continue;
+    std::string path = line.rfind("images:", 0) == 0 ? line.substr(7) : line;
+    if (fs::is_directory(path)) {
+      folders.emplace_back(path);
+    } else {
+      warnings.push_back("source.txt: cannot show frames of '" + line +
+                         "' (not an image folder); give --frames DIR");
+    }
+  }
+  return folders;
+}
+
+std::vector<std::string> imageFiles(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp" || ext == ".ppm" || ext == ".pgm") {
+      names.push_back(entry.path().filename().string());
+    }
+  }
+  sortNatural(names);
+  return names;
+}
+
+std::string thumbnailDataUri(const fs::path& path) {
+  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  if (image.empty()) return "";
+  const int width = 160;
+  const int height = std::max(1, image.rows * width / std::max(1, image.cols));
+  cv::Mat small;
+  cv::resize(image, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  std::vector<std::uint8_t> jpeg;
+  cv::imencode(".jpg", small, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  return "data:image/jpeg;base64," + eval::base64Encode(jpeg);
+}
+
+void runReport(const ReportCommandOptions& o) {
+  eval::ReportInputs in;
+  in.run = eval::loadRun(o.run_dir);
+  in.title = o.title.empty()
+                 ? "toposlam report: " + fs::path(o.run_dir).lexically_normal().filename().string()
+                 : o.title;
+  if (!o.truth.empty()) {
+    const eval::Truth truth = eval::loadTruth(o.truth);
+    in.eval = eval::evaluate(in.run, truth, o.eval);
+    if (truth.kind == eval::Truth::Kind::Labels) {
+      for (const auto& l : truth.labels) in.rooms.push_back(l.room);
+    }
+  }
+
+  const std::vector<fs::path> folders = frameFolders(o, in.warnings);
+  in.thumbnails.assign(in.run.frames.size(), "");
+  if (folders.empty()) {
+    in.warnings.push_back(
+        "no frames found (no --frames DIR, RUN_DIR/frames or RUN_DIR/source.txt): figures without "
+        "thumbnails");
+  } else {
+    // Frames are looked up per source of the run (time going back), one folder each.
+    const std::vector<std::int64_t>& source_starts = in.run.traversal_starts;
+    std::vector<std::vector<std::string>> listings(folders.size());
+    int missing = 0;
+    for (std::int64_t f : eval::framesForThumbnails(in.run, o.thumbnails)) {
+      const int source = eval::traversalOf(f, source_starts);
+      const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(source), folders.size() - 1);
+      const std::string& name = in.run.frames[static_cast<std::size_t>(f)].name;
+      fs::path path = folders[k] / name;
+      if (name.empty() || !fs::exists(path)) {
+        if (listings[k].empty()) listings[k] = imageFiles(folders[k]);
+        const auto index =
+            static_cast<std::size_t>(f - source_starts[static_cast<std::size_t>(std::min<std::size_t>(
+                                             static_cast<std::size_t>(source), source_starts.size() - 1))]);
+        path = index < listings[k].size() ? folders[k] / listings[k][index] : fs::path();
+      }
+      std::string uri = path.empty() ? "" : thumbnailDataUri(path);
+      if (uri.empty()) ++missing;
+      in.thumbnails[static_cast<std::size_t>(f)] = std::move(uri);
+    }
+    if (missing > 0)
+      in.warnings.push_back(std::to_string(missing) + " frames could not be read for thumbnails");
+  }
+
+  const fs::path out = o.out.empty() ? fs::path(o.run_dir) / "report.html" : fs::path(o.out);
+  std::ofstream html(out, std::ios::binary);
+  if (!html) throw std::runtime_error(out.string() + ": cannot write the report");
+  html << eval::renderReportHtml(in);
+  html.close();
+  if (!html) throw std::runtime_error(out.string() + ": error while writing");
+  if (!o.figures.empty()) {
+    fs::create_directories(o.figures);
+    for (const auto& [name, svg] : eval::renderReportFigures(in)) {
+      std::ofstream file(fs::path(o.figures) / name, std::ios::binary);
+      file << svg;
+      if (!file) throw std::runtime_error(o.figures + "/" + name + ": cannot write");
+    }
+    std::cout << "wrote the figures as SVG files into " << o.figures << "\n";
+  }
+  for (const auto& w : in.warnings) std::cerr << "report: warning: " << w << "\n";
+  std::cout << "wrote " << out.string() << " (" << fs::file_size(out) / 1024 << " KiB)\n";
+}
+
+}  // namespace
+
+void addReportCommand(CLI::App& app) {
+  auto options = std::make_shared<ReportCommandOptions>();
+  auto* cmd = app.add_subcommand("report",
+                                 "One self-contained HTML page with the figures and tables of a run folder");
+  cmd->add_option("run_dir", options->run_dir, "Run folder written by `toposlam segment` or `toposlam map`")
+      ->required();
+  cmd->add_option("--truth", options->truth,
+                  "Ground truth as for `toposlam eval` (adds the evaluation tables)");
+  cmd->add_option("--frames", options->frames,
+                  "Folder of the run's frames, one per source in order (thumbnails)");
+  cmd->add_option("--out", options->out, "Output HTML file (default RUN_DIR/report.html)");
+  cmd->add_option("--title", options->title, "Page title");
+  cmd->add_option("--figures", options->figures,
+                  "Also write each figure as a standalone SVG file into this folder");
+  cmd->add_option("--thumbnails", options->thumbnails, "About this many evenly spaced frame thumbnails")
+      ->check(CLI::Range(0, 2000))
+      ->capture_default_str();
+  cmd->add_option("--tolerance", options->eval.tolerance, "As for `toposlam eval`")->capture_default_str();
+  cmd->add_option("--min-gap", options->eval.min_gap, "As for `toposlam eval`")->capture_default_str();
+  cmd->add_option("--traversals", options->eval.traversals, "As for `toposlam eval`")->capture_default_str();
+  cmd->callback([options] { runReport(*options); });
+}
+
+}  // namespace toposlam::cli

@@ -1,0 +1,282 @@
+// toposlamd's body; see daemon.hpp. Signals: SIGTERM/SIGINT/SIGHUP are blocked in every thread (the mask is
+// set before any thread exists, threads inherit it) and taken synchronously by the main thread with
+// sigtimedwait(), so no work happens in a signal handler.
+#include "daemon.hpp"
+
+#include <signal.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <spdlog/spdlog.h>
+
+#include "sources.hpp"
+#include "toposlam/core/worker_pool.hpp"
+#include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/pipeline/algorithm_stages.hpp"
+#include "toposlam/pipeline/pipeline.hpp"
+#include "toposlam/pipeline/thread_table.hpp"
+#include "toposlam/platform/lcm_transport.hpp"
+#include "toposlam/platform/systemd_notifier.hpp"
+#include "toposlam/topology/map_store.hpp"
+
+namespace toposlam::daemon {
+
+namespace {
+
+sigset_t stopSignals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGHUP);
+  return set;
+}
+
+/// Waits up to `seconds` for a stop signal; returns its number or 0.
+int waitForSignal(const sigset_t& set, double seconds) {
+  timespec timeout{};
+  timeout.tv_sec = static_cast<time_t>(seconds);
+  timeout.tv_nsec = static_cast<long>((seconds - std::floor(seconds)) * 1e9);
+  siginfo_t info{};
+  const int signal = sigtimedwait(&set, &info, &timeout);
+  return signal > 0 ? signal : 0;
+}
+
+LcmChannels channelsOf(const LcmSettings& lcm) {
+  LcmChannels c;
+  c.place = lcm.place_channel;
+  c.place_event = lcm.place_event_channel;
+  c.topology = lcm.topology_channel;
+  c.status = lcm.status_channel;
+  c.motion = lcm.motion_channel;
+  return c;
+}
+
+std::string statusLine(const PipelineStatus& s) {
+  char text[256];
+  std::snprintf(text, sizeof text, "%s: %.1f fps, latency p99 %.1f ms, %d places, map rev %lld, %lld dropped",
+                s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
+                static_cast<long long>(s.frames_dropped));
+  return text;
+}
+
+/// Everything one run needs, built from the config in dependency order.
+struct Assembly {
+  std::unique_ptr<FrameSource> source;
+  std::unique_ptr<WorkerPool> pool;
+  std::unique_ptr<VpackFingerprintStage> fingerprint;
+  std::unique_ptr<NgramSimilarity> similarity;
+  std::unique_ptr<FiedlerSegmentationStage> segmentation;
+  std::unique_ptr<ParticleFilterTopologyStage> topology;
+
+  Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri) {
+    source = openSource(source_uri);
+    pool = std::make_unique<WorkerPool>(config.fingerprint_workers, "tsl-vpack");
+    fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get());
+    similarity = std::make_unique<NgramSimilarity>(config.similarity);
+    segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity);
+    topology = std::make_unique<ParticleFilterTopologyStage>(config.topology, *similarity, clock,
+                                                             config.topology_slice_items, config.topology_alternatives);
+  }
+};
+
+}  // namespace
+
+std::string resolveMapPath(const std::string& path) {
+  if (path.empty()) return path;
+  std::filesystem::path p(path);
+  if (p.is_absolute()) return path;
+  if (const char* state = std::getenv("STATE_DIRECTORY"); state != nullptr && state[0] != '\0') {
+    std::string first(state);
+    first = first.substr(0, first.find(':'));  // several StateDirectory= entries are colon-separated
+    return (std::filesystem::path(first) / p).string();
+  }
+  return path;
+}
+
+int runDaemon(const DaemonConfig& config) {
+  const sigset_t signals = stopSignals();
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // before any thread exists: all inherit it
+
+  SystemdNotifier notifier;
+  SteadyClock clock;
+  PipelineConfig pipeline_config = config.pipeline;
+  pipeline_config.map_path = resolveMapPath(config.pipeline.map_path);
+
+  Assembly parts(config, clock, config.source);
+  spdlog::info("toposlamd: source {}", parts.source->describe());
+
+  if (config.load_map_at_start && !pipeline_config.map_path.empty() &&
+      std::filesystem::exists(pipeline_config.map_path)) {
+    try {
+      parts.topology->loadMap(pipeline_config.map_path);
+      spdlog::info("toposlamd: resumed the map {} ({} places)", pipeline_config.map_path, parts.topology->observations());
+    } catch (const std::exception& e) {
+      // A damaged map must not keep the robot from starting: keep it aside for a human, start afresh.
+      const std::string aside = pipeline_config.map_path + ".damaged";
+      std::error_code ec;
+      std::filesystem::rename(pipeline_config.map_path, aside, ec);
+      spdlog::error("toposlamd: cannot load the map {} ({}); moved it to {} and starting a new map",
+                    pipeline_config.map_path, e.what(), aside);
+    }
+  }
+
+  // Motion input: counted (the filter does not use odometry yet; see docs/daemon.md).
+  std::atomic<std::int64_t> motion_messages{0};
+  std::atomic<bool> receiving{true};
+  const LcmChannels channels = channelsOf(config.lcm);
+  LcmSubscriber motion(config.lcm.url, channels, {channels.motion},
+                       [&](const ReceivedMessage&) { motion_messages.fetch_add(1); });
+  LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_messages);
+
+  Pipeline pipeline(pipeline_config, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink,
+                    clock);
+  ThreadTable io_threads;
+  io_threads.start(ThreadSettings{"tsl-lcm-rx"}, [&] {
+    while (receiving.load())
+      if (!motion.handle(200)) break;
+  });
+  pipeline.start();
+  notifier.ready();
+  notifier.status("running: " + parts.source->describe());
+  spdlog::info("toposlamd: running; publishing on {} ({})", config.lcm.url, channels.place);
+
+  const double watchdog_s = config.watchdog ? notifier.watchdogPeriodSeconds() : 0.0;
+  // Ping twice per watchdog period; otherwise wake once a second for the status line.
+  const double tick_s = watchdog_s > 0 ? std::min(1.0, watchdog_s / 2.0) : 1.0;
+  bool stopping = false;
+  while (!pipeline.finished()) {
+    // Once stopping, look for the end more often so the exit follows the map save closely.
+    const int signal = waitForSignal(signals, stopping ? std::min(tick_s, 0.1) : tick_s);
+    if (signal != 0 && !stopping) {
+      stopping = true;
+      spdlog::info("toposlamd: {} received: finishing the filter step in progress and saving the map",
+                   strsignal(signal));
+      notifier.stopping();
+      notifier.status("stopping: finishing the filter step and saving the map");
+      pipeline.requestStop();
+    }
+    if (watchdog_s > 0 && pipeline.healthy()) notifier.watchdog();
+    if (!stopping) notifier.status(statusLine(pipeline.status()));
+  }
+  pipeline.wait();
+  receiving.store(false);
+  io_threads.joinAll();
+
+  const std::string error = pipeline.error();
+  const PipelineStatus last = pipeline.status();
+  spdlog::info("toposlamd: {} frames published, {} dropped, {} places, {} map saves",
+               last.frames_published, last.frames_dropped, last.places, last.maps_saved);
+  if (!error.empty()) {
+    notifier.status("failed: " + error);
+    spdlog::error("toposlamd: {}", error);
+    return 1;
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------------------------------------------------
+
+namespace {
+
+/// Adds or replaces query parameters of a URI ("sim:office?route=loop2" + size=640x480).
+std::string withParameter(const std::string& uri, const std::string& key, const std::string& value) {
+  const std::size_t q = uri.find('?');
+  std::string base = q == std::string::npos ? uri : uri.substr(0, q);
+  std::string query = q == std::string::npos ? "" : uri.substr(q + 1);
+  std::string out_query;
+  std::istringstream parts(query);
+  std::string part;
+  while (std::getline(parts, part, '&'))
+    if (!part.empty() && part.rfind(key + "=", 0) != 0) out_query += (out_query.empty() ? "" : "&") + part;
+  out_query += (out_query.empty() ? "" : "&") + key + "=" + value;
+  return base + "?" + out_query;
+}
+
+/// Forwards to the LCM sink and stops the pipeline after `limit` frames.
+class CountingSink final : public PipelineSink {
+ public:
+  CountingSink(PipelineSink& inner, int limit) : inner_(inner), limit_(limit) {}
+  void publish(const FrameResult& r) override {
+    inner_.publish(r);
+    if (r.has_frame) {
+      ++frames_;
+      step_finished_.push_back(!r.finished_places.empty());  // same order as Pipeline::latencies()
+    }
+    places_ += static_cast<int>(r.finished_places.size());
+  }
+  /// Per published frame: a filter step finished on it (the frames where a spike would show).
+  const std::vector<bool>& stepFinished() const { return step_finished_; }
+  void publishStatus(const PipelineStatus& s) override { inner_.publishStatus(s); }
+  int frames() const { return frames_.load(); }
+  int places() const { return places_.load(); }
+  bool done() const { return frames_.load() >= limit_; }
+
+ private:
+  PipelineSink& inner_;
+  int limit_;
+  std::atomic<int> frames_{0};
+  std::atomic<int> places_{0};
+  std::vector<bool> step_finished_;
+};
+
+}  // namespace
+
+int runBench(const DaemonConfig& config, const BenchOptions& options) {
+  SteadyClock clock;
+  const LcmChannels channels = channelsOf(config.lcm);
+  LcmPipelineSink lcm_sink(options.lcm_url.empty() ? config.lcm.url : options.lcm_url, channels, config.lcm.jpeg_quality);
+  std::printf("toposlamd --bench: %d frames per run, source %s, filter budget %.1f ms/frame, %d particles\n",
+              options.frames, options.source.c_str(), config.pipeline.filter_budget_ms, config.topology.particles);
+  std::printf("%-9s %-11s %8s %9s %9s %9s %13s %8s %7s %6s\n", "size", "mode", "fps", "median_ms", "p99_ms", "max_ms",
+              "step_max_ms", "frames", "drops", "places");
+  for (const char* size : {"320x240", "640x480"}) {
+    // throughput: the source as fast as possible, lossless queues; realtime: 30 fps, drop-oldest queues.
+    for (const bool realtime : {false, true}) {
+      DaemonConfig c = config;
+      c.pipeline.map_path.clear();
+      c.pipeline.record_latencies = true;
+      c.pipeline.queues.overflow = realtime ? QueueOverflow::DropOldest : QueueOverflow::Block;
+      std::string uri = withParameter(options.source, "size", size);
+      if (realtime) uri = withParameter(uri, "rate", "30");  // the source paces itself at 30 Hz
+      Assembly parts(c, clock, uri);
+      CountingSink sink(lcm_sink, options.frames);
+      Pipeline pipeline(c.pipeline, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink, clock);
+      const double t0 = clock.now();
+      pipeline.start();
+      while (!pipeline.finished() && !sink.done()) {
+        timespec nap{0, 5'000'000};  // the benchmark's own polling, not a synchronisation
+        nanosleep(&nap, nullptr);
+      }
+      pipeline.requestStop();
+      pipeline.wait();
+      const double elapsed = clock.now() - t0;
+      std::vector<double> latencies = pipeline.latencies();
+      // Frames on which a place's filter step finished: with the step spread, they must not stand out.
+      std::vector<double> step_frames;
+      for (std::size_t i = 0; i < latencies.size() && i < sink.stepFinished().size(); ++i)
+        if (sink.stepFinished()[i]) step_frames.push_back(latencies[i]);
+      const LatencyStats step_stats = summarizeLatencies(step_frames);
+      const LatencyStats stats = summarizeLatencies(latencies);
+      const PipelineStatus status = pipeline.status();
+      std::printf("%-9s %-11s %8.1f %9.2f %9.2f %9.2f %13.2f %8lld %7lld %6d\n", size,
+                  realtime ? "realtime30" : "throughput", static_cast<double>(sink.frames()) / elapsed, stats.median_ms,
+                  stats.p99_ms, stats.max_ms, step_stats.max_ms,
+                  static_cast<long long>(stats.samples), static_cast<long long>(status.frames_dropped), sink.places());
+      if (!pipeline.error().empty()) std::printf("  error: %s\n", pipeline.error().c_str());
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
+}  // namespace toposlam::daemon

@@ -1,0 +1,94 @@
+// toposlamd: the real-time topological SLAM service. Reads one config (default
+// $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
+// runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "daemon.hpp"
+#include "toposlam/config/daemon_config.hpp"
+
+namespace {
+
+#ifndef TOPOSLAM_INSTALLED_CONFIG
+#define TOPOSLAM_INSTALLED_CONFIG "/etc/toposlam/toposlam.yaml"
+#endif
+
+// $CONFIGURATION_DIRECTORY/toposlam.yaml (systemd ConfigurationDirectory=), then /etc/toposlam/toposlam.yaml,
+// then the copy `cmake --install` put under the install prefix; the first that exists wins.
+std::string defaultConfigPath() {
+  std::vector<std::string> candidates;
+  if (const char* dir = std::getenv("CONFIGURATION_DIRECTORY"); dir != nullptr && dir[0] != '\0') {
+    std::string first(dir);
+    first = first.substr(0, first.find(':'));
+    candidates.push_back((std::filesystem::path(first) / "toposlam.yaml").string());
+  }
+  candidates.push_back("/etc/toposlam/toposlam.yaml");
+  candidates.push_back(TOPOSLAM_INSTALLED_CONFIG);
+  for (const std::string& c : candidates)
+    if (std::filesystem::exists(c)) return c;
+  return candidates.front();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
+  app.set_version_flag("--version", "toposlamd 0.1.0");
+  std::string config_path;
+  std::string source, map_path, lcm_url, overflow;
+  bool check_only = false, no_load = false, bench = false;
+  double save_period = -1.0;
+  toposlam::daemon::BenchOptions bench_options;
+  app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
+                                                 defaultConfigPath() + " if it exists, else built-in defaults");
+  app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
+  app.add_option("--map", map_path, "override `map.path` (relative paths resolve against $STATE_DIRECTORY)");
+  app.add_option("--lcm-url", lcm_url, "override `lcm.url`");
+  app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
+  app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
+  app.add_flag("--no-map-load", no_load, "start a new map even if the map file exists");
+  app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
+  app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
+  app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    toposlam::DaemonConfig config;
+    const bool explicit_config = !config_path.empty();
+    if (!explicit_config) config_path = defaultConfigPath();
+    if (explicit_config || std::filesystem::exists(config_path)) {
+      config = toposlam::loadDaemonConfig(config_path);
+    } else {
+      config_path = "(built-in defaults)";
+    }
+    if (!source.empty()) config.source = source;
+    if (!map_path.empty()) config.pipeline.map_path = map_path;
+    if (!lcm_url.empty()) config.lcm.url = lcm_url;
+    if (overflow == "block") config.pipeline.queues.overflow = toposlam::QueueOverflow::Block;
+    if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
+    if (save_period >= 0.0) config.pipeline.map_save_period_s = save_period;
+    if (no_load) config.load_map_at_start = false;
+    if (std::string problem = config.validate(); !problem.empty())
+      throw toposlam::ConfigError("command line: " + problem);
+    if (check_only) {
+      std::cout << "toposlamd: config OK: " << config_path << "\n";
+      return 0;
+    }
+    spdlog::info("toposlamd: config {}", config_path);
+    if (bench) {
+      bench_options.source = config.source;
+      return toposlam::daemon::runBench(config, bench_options);
+    }
+    return toposlam::daemon::runDaemon(config);
+  } catch (const std::exception& e) {
+    std::cerr << "toposlamd: error: " << e.what() << "\n";
+    return 2;
+  }
+}

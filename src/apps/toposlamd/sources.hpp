@@ -1,0 +1,15 @@
+// The one seam between toposlamd and the frame sources: openFrameSource(uri) from toposlam_sources
+// (io/source_factory.hpp) when that library is built; otherwise a clear error.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "toposlam/io/frame_source.hpp"
+
+namespace toposlam::daemon {
+
+/// Throws FrameSourceError (or std::invalid_argument for a malformed URI) with an actionable message.
+std::unique_ptr<FrameSource> openSource(const std::string& uri);
+
+}  // namespace toposlam::daemon

@@ -1,0 +1,535 @@
+// Run folder + ground truth -> EvalResult, and its text / JSON / HTML forms (see evaluation.hpp).
+#include "toposlam/eval/evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "toposlam/core/json_writer.hpp"
+
+namespace toposlam::eval {
+
+namespace fs = std::filesystem;
+
+RunData loadRun(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw RunFileError(dir + ": not a run folder (no such directory)");
+  RunData run;
+  run.dir = dir;
+  const fs::path root(dir);
+  if (!fs::exists(root / "frames.csv")) {
+    throw RunFileError((root / "frames.csv").string() +
+                       ": missing; give a folder written by `toposlam segment` or `toposlam map`");
+  }
+  run.frames = loadFrames((root / "frames.csv").string());
+  if (fs::exists(root / "places.csv")) run.places = loadPlaces((root / "places.csv").string());
+  if (fs::exists(root / "dropped_places.csv"))
+    run.dropped_places = loadPlaces((root / "dropped_places.csv").string());
+  if (fs::exists(root / "topology.json")) run.topology = loadTopology((root / "topology.json").string());
+  if (fs::exists(root / "timing.csv")) run.timing = loadTiming((root / "timing.csv").string());
+  run.traversal_starts.push_back(0);
+  for (std::size_t f = 1; f < run.frames.size(); ++f) {
+    if (run.frames[f].time_s < run.frames[f - 1].time_s)
+      run.traversal_starts.push_back(static_cast<std::int64_t>(f));
+  }
+  return run;
+}
+
+std::vector<std::int64_t> splitTraversals(std::int64_t frame_count, int count) {
+  std::vector<std::int64_t> starts;
+  for (int t = 0; t < std::max(1, count); ++t) starts.push_back(frame_count * t / std::max(1, count));
+  return starts;
+}
+
+Truth loadTruth(const std::string& path) {
+  Truth truth;
+  truth.path = path;
+  const std::string ext = fs::path(path).extension().string();
+  if (ext == ".csv" || ext == ".CSV") {
+    const CsvTable table = readCsv(path);
+    const bool labels = std::find(table.header.begin(), table.header.end(), "room") != table.header.end();
+    if (labels) {
+      truth.kind = Truth::Kind::Labels;
+      truth.labels = loadLabels(path);
+    } else {
+      truth.kind = Truth::Kind::Pairs;
+      truth.pairs = loadLoopClosurePairs(path);
+    }
+  } else {
+    truth.kind = Truth::Kind::Matrix;
+    truth.matrix = loadLoopClosureImage(path);
+  }
+  return truth;
+}
+
+Truth loadTruth(const std::vector<std::string>& paths) {
+  if (paths.empty())
+    throw std::invalid_argument("--truth: give labels.csv, a loop-closure matrix image or a pairs CSV");
+  Truth truth = loadTruth(paths.front());
+  truth.file_starts = {0};
+  for (std::size_t k = 1; k < paths.size(); ++k) {
+    const Truth more = loadTruth(paths[k]);
+    if (truth.kind != Truth::Kind::Labels || more.kind != Truth::Kind::Labels) {
+      throw std::invalid_argument("--truth: only labels.csv files can be combined (one per traversal); " +
+                                  paths[k] + " or " + paths.front() +
+                                  " is a loop-closure matrix or pairs file");
+    }
+    const auto offset = static_cast<std::int64_t>(truth.labels.size());
+    truth.file_starts.push_back(offset);
+    for (LabelRow row : more.labels) {
+      row.frame += offset;
+      truth.labels.push_back(row);
+    }
+    truth.path += "+" + paths[k];
+  }
+  return truth;
+}
+
+std::vector<double> frameNodeProbabilities(const RunData& run) {
+  std::map<int, double> of_place;
+  if (run.topology) {
+    for (const auto& step : run.topology->history) of_place[step.place] = step.probability;
+  }
+  std::vector<double> p(run.frames.size(), 1.0);
+  for (std::size_t f = 0; f < run.frames.size(); ++f) {
+    const auto it = of_place.find(run.frames[f].place);
+    if (it != of_place.end()) p[f] = it->second;
+  }
+  return p;
+}
+
+std::vector<std::int64_t> predictedCuts(const RunData& run,
+                                        const std::vector<std::int64_t>& traversal_starts) {
+  const std::set<std::int64_t> starts(traversal_starts.begin(), traversal_starts.end());
+  std::set<std::int64_t> cuts;
+  for (const auto* list : {&run.places, &run.dropped_places}) {
+    for (const auto& p : *list) {
+      if (p.first > 0 && starts.count(p.first) == 0) cuts.insert(p.first);
+    }
+  }
+  return {cuts.begin(), cuts.end()};
+}
+
+namespace {
+
+std::string kindName(Truth::Kind k) {
+  switch (k) {
+    case Truth::Kind::Labels:
+      return "labels";
+    case Truth::Kind::Matrix:
+      return "matrix";
+    case Truth::Kind::Pairs:
+      return "pairs";
+  }
+  return "?";
+}
+
+LoopClosureMatrix matrixFromPairs(const Truth& truth, const RunData& run) {
+  std::map<std::string, int> frame_of_name;
+  for (const auto& f : run.frames) {
+    if (!f.name.empty()) frame_of_name.emplace(f.name, static_cast<int>(f.frame));
+  }
+  LoopClosureMatrix m;
+  m.size = static_cast<int>(run.frames.size());
+  m.same.assign(static_cast<std::size_t>(m.size) * static_cast<std::size_t>(m.size), 0);
+  auto resolve = [&](const std::string& name, int line) {
+    const auto it = frame_of_name.find(name);
+    if (it != frame_of_name.end()) return it->second;
+    throw RunFileError(truth.path + ":" + std::to_string(line) + ": frame '" + name + "' is not in " +
+                       run.dir + "/frames.csv (column name)");
+  };
+  for (const auto& p : truth.pairs) {
+    const int i = resolve(p.query, p.line), j = resolve(p.match, p.line);
+    m.same[static_cast<std::size_t>(i * m.size + j)] = 1;
+    m.same[static_cast<std::size_t>(j * m.size + i)] = 1;
+  }
+  return m;
+}
+
+}  // namespace
+
+EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& options) {
+  EvalResult result;
+  result.run_dir = run.dir;
+  result.truth_path = truth.path;
+  result.truth_kind = kindName(truth.kind);
+  result.frames = static_cast<int>(run.frames.size());
+  result.places = static_cast<int>(run.places.size());
+  result.dropped_places = static_cast<int>(run.dropped_places.size());
+  const std::int64_t n = static_cast<std::int64_t>(run.frames.size());
+  const std::vector<std::int64_t> starts = options.traversals > 0 ? splitTraversals(n, options.traversals)
+                                           : truth.file_starts.size() > 1 ? truth.file_starts
+                                                                          : run.traversal_starts;
+  result.traversals = static_cast<int>(starts.size());
+  result.traversal_starts = starts;
+  result.min_gap = options.min_gap >= 0 ? options.min_gap : (truth.kind == Truth::Kind::Labels ? 0 : 25);
+
+  const bool has_nodes =
+      std::any_of(run.frames.begin(), run.frames.end(), [](const FrameRecord& f) { return f.node >= 0; });
+  std::vector<int> node_of_frame;
+  for (const auto& f : run.frames) node_of_frame.push_back(f.node);
+  const std::vector<double> probability = frameNodeProbabilities(run);
+
+  std::vector<int> rooms;
+  if (truth.kind == Truth::Kind::Labels) {
+    if (static_cast<std::int64_t>(truth.labels.size()) != n) {
+      throw RunFileError(truth.path + ": has " + std::to_string(truth.labels.size()) + " frames but " +
+                         run.dir + "/frames.csv has " + std::to_string(n) +
+                         " (give the labels of every traversal, in order)");
+    }
+    for (const auto& l : truth.labels) rooms.push_back(l.room);
+  }
+
+  // Loop closure.
+  if (has_nodes) {
+    LoopClosureTruth lct;
+    if (truth.kind == Truth::Kind::Labels) {
+      lct = truthFromRooms(rooms, result.min_gap);
+    } else {
+      const LoopClosureMatrix m =
+          truth.kind == Truth::Kind::Matrix ? truth.matrix : matrixFromPairs(truth, run);
+      if (m.size != n) {
+        throw RunFileError(truth.path + ": loop-closure matrix is " + std::to_string(m.size) + "x" +
+                           std::to_string(m.size) + " but " + run.dir + "/frames.csv has " +
+                           std::to_string(n) + " frames");
+      }
+      lct = truthFromMatrix(m, result.min_gap);
+    }
+    result.loop_closure = precisionRecall(lct, pairsFromAssignments(node_of_frame, probability));
+  } else {
+    result.notes.push_back(
+        "no topological nodes in frames.csv (a `segment` run?): no loop-closure or topology measures");
+  }
+
+  if (truth.kind != Truth::Kind::Labels) {
+    result.notes.push_back("ground truth is a loop-closure " + result.truth_kind +
+                           ": localisation, segmentation and topology measures need labels.csv");
+  } else {
+    // Localisation: a node stands for the room most of its frames are in.
+    if (has_nodes) {
+      std::map<int, std::vector<int>> rooms_of_node;
+      for (std::size_t f = 0; f < rooms.size(); ++f) {
+        if (node_of_frame[f] >= 0) rooms_of_node[node_of_frame[f]].push_back(rooms[f]);
+      }
+      std::map<int, int> room_of_node;
+      for (const auto& [node, rs] : rooms_of_node) room_of_node[node] = majority(rs);
+      std::vector<LocalisationPrediction> predictions;
+      for (std::size_t f = 0; f < rooms.size(); ++f) {
+        if (node_of_frame[f] < 0 || rooms[f] < 0) continue;
+        predictions.push_back(LocalisationPrediction{std::to_string(room_of_node[node_of_frame[f]]),
+                                                     std::to_string(rooms[f]), probability[f]});
+      }
+      result.localisation = localisationTable(predictions, options.thresholds);
+    }
+    result.boundaries =
+        scoreBoundaries(predictedCuts(run, starts), roomBoundaries(rooms, starts), options.tolerance);
+    std::vector<std::int64_t> reps;
+    for (const auto& p : run.places) {
+      if (p.representative < n) reps.push_back(p.representative);
+    }
+    result.places_per_traversal = placesPerTraversal(reps, rooms, starts);
+    result.consistency = crossTraversalConsistency(reps, rooms, starts);
+    if (has_nodes) {
+      std::vector<int> place_node, place_room;
+      for (const auto& p : run.places) {
+        if (p.node < 0 || p.last >= n) continue;
+        place_node.push_back(p.node);
+        int r = rooms[static_cast<std::size_t>(p.representative)];
+        if (r < 0) {
+          std::vector<int> rs(rooms.begin() + p.first, rooms.begin() + p.last + 1);
+          r = majority(rs);
+        }
+        place_room.push_back(r);
+      }
+      result.topology = scoreTopology(place_node, place_room);
+    }
+  }
+  if (run.topology) {
+    for (const auto& s : run.topology->history)
+      result.best_topology_probability.push_back(s.best_topology_probability);
+  }
+  return result;
+}
+
+// ---------------------------------------------------------------- output
+
+void writeEvalJson(std::ostream& out, const EvalResult& r) {
+  JsonWriter json(out);
+  json.beginObject();
+  json.field("run", r.run_dir).field("truth", r.truth_path).field("truth_kind", r.truth_kind);
+  json.field("frames", r.frames).field("places", r.places).field("dropped_places", r.dropped_places);
+  json.field("traversals", r.traversals).field("min_gap", r.min_gap);
+  if (r.localisation) {
+    json.key("localisation").beginArray();
+    for (const auto& row : *r.localisation) {
+      json.beginObject()
+          .field("threshold", row.threshold)
+          .field("images", row.images)
+          .field("correct", row.correct)
+          .field("precision", row.precision)
+          .endObject();
+    }
+    json.endArray();
+  }
+  if (r.loop_closure) {
+    const PrCurve& c = *r.loop_closure;
+    json.key("loop_closure").beginObject();
+    json.field("positives", c.positives).field("predicted", c.predicted);
+    json.field("recall_at_100_precision", c.recall_at_full_precision);
+    json.field("threshold_at_100_precision", c.threshold_at_full_precision);
+    json.field("average_precision", c.average_precision);
+    json.key("curve").beginArray();
+    for (const auto& p : c.points) {
+      json.beginObject()
+          .field("threshold", p.threshold)
+          .field("true_positives", p.true_positives)
+          .field("false_positives", p.false_positives)
+          .field("precision", p.precision)
+          .field("recall", p.recall)
+          .endObject();
+    }
+    json.endArray().endObject();
+  }
+  if (r.boundaries) {
+    const BoundaryScore& b = *r.boundaries;
+    json.key("segmentation").beginObject();
+    json.field("tolerance", b.tolerance)
+        .field("predicted_boundaries", b.predicted)
+        .field("true_boundaries", b.truth)
+        .field("matched", b.matched)
+        .field("precision", b.precision)
+        .field("recall", b.recall)
+        .field("f1", b.f1)
+        .field("mean_offset_frames", b.mean_offset);
+    if (r.places_per_traversal) {
+      json.key("places_per_traversal").beginArray();
+      for (const auto& t : *r.places_per_traversal) {
+        json.beginObject()
+            .field("traversal", t.traversal)
+            .field("places", t.places)
+            .field("room_visits", t.room_visits)
+            .endObject();
+      }
+      json.endArray();
+    }
+    if (r.consistency) {
+      json.key("consistency").beginObject();
+      json.field("eligible_rooms", r.consistency->eligible)
+          .field("consistent_rooms", r.consistency->consistent)
+          .field("rate", r.consistency->rate);
+      json.key("rooms").beginArray();
+      for (const auto& rc : r.consistency->rooms) {
+        json.beginObject().field("room", rc.room);
+        json.key("visits").beginArray();
+        for (int v : rc.visits) json.value(v);
+        json.endArray().key("places").beginArray();
+        for (int v : rc.places) json.value(v);
+        json.endArray().endObject();
+      }
+      json.endArray().endObject();
+    }
+    json.endObject();
+  }
+  if (r.topology) {
+    const TopologyScore& t = *r.topology;
+    json.key("topology").beginObject();
+    json.field("nodes", t.nodes)
+        .field("rooms", t.rooms)
+        .field("one_to_one", t.one_to_one)
+        .field("merged_nodes", t.merged_nodes)
+        .field("split_rooms", t.split_rooms)
+        .field("loop_closures", t.loop_closures)
+        .field("wrong_loop_closures", t.wrong_loop_closures)
+        .field("missed_loop_closures", t.missed_loop_closures);
+    json.endObject();
+  }
+  json.key("best_topology_probability").beginArray();
+  for (double p : r.best_topology_probability) json.value(p);
+  json.endArray();
+  json.key("notes").beginArray();
+  for (const auto& note : r.notes) json.value(note);
+  json.endArray();
+  json.endObject();
+  out << "\n";
+}
+
+namespace {
+
+std::string fmt(const char* format, double v) {
+  if (!std::isfinite(v)) return "-";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, v);
+  return buffer;
+}
+std::string percent(double v) { return fmt("%.2f%%", 100.0 * v); }
+
+/// A table as header + rows of cells; rendered as aligned text or HTML.
+struct Table {
+  std::string title;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+};
+
+std::vector<Table> tables(const EvalResult& r) {
+  std::vector<Table> out;
+  if (r.localisation) {
+    Table t{
+        "Localisation (thesis Table 3.1): frames whose node probability >= threshold, and how many of them "
+        "are in the room their node stands for",
+        {"threshold", "images", "correct", "precision"},
+        {}};
+    for (const auto& row : *r.localisation) {
+      t.rows.push_back({fmt("%.1f", row.threshold), std::to_string(row.images), std::to_string(row.correct),
+                        percent(row.precision)});
+    }
+    out.push_back(t);
+  }
+  if (r.loop_closure) {
+    const PrCurve& c = *r.loop_closure;
+    Table t{"Loop closure (frame pairs on the same node; pairs within " + std::to_string(r.min_gap) +
+                " frames not evaluated)",
+            {"measure", "value"},
+            {}};
+    t.rows.push_back({"ground-truth pairs", std::to_string(c.positives)});
+    t.rows.push_back({"predicted pairs", std::to_string(c.predicted)});
+    t.rows.push_back({"recall at 100% precision", percent(c.recall_at_full_precision)});
+    if (!c.points.empty()) {
+      t.rows.push_back({"precision (all predictions)", percent(c.points.back().precision)});
+      t.rows.push_back({"recall (all predictions)", percent(c.points.back().recall)});
+    }
+    t.rows.push_back({"average precision", fmt("%.3f", c.average_precision)});
+    out.push_back(t);
+  }
+  if (r.boundaries) {
+    const BoundaryScore& b = *r.boundaries;
+    Table t{"Segmentation: place cuts vs. room changes, tolerance " + std::to_string(b.tolerance) + " frames",
+            {"cuts", "room changes", "matched", "precision", "recall", "F1", "mean offset (frames)"},
+            {{std::to_string(b.predicted), std::to_string(b.truth), std::to_string(b.matched),
+              percent(b.precision), percent(b.recall), fmt("%.3f", b.f1), fmt("%+.1f", b.mean_offset)}}};
+    out.push_back(t);
+  }
+  if (r.places_per_traversal) {
+    Table t{"Places per traversal", {"traversal", "places", "room visits"}, {}};
+    for (const auto& row : *r.places_per_traversal) {
+      t.rows.push_back(
+          {std::to_string(row.traversal + 1), std::to_string(row.places), std::to_string(row.room_visits)});
+    }
+    out.push_back(t);
+  }
+  if (r.consistency && r.traversals > 1) {
+    Table t{"Consistency across traversals: places per room in each traversal (rate " +
+                percent(r.consistency->rate) + " = " + std::to_string(r.consistency->consistent) + " of " +
+                std::to_string(r.consistency->eligible) + " rooms yield a place in every traversal)",
+            {"room", "visits", "places"},
+            {}};
+    for (const auto& rc : r.consistency->rooms) {
+      std::string visits, places;
+      for (std::size_t k = 0; k < rc.visits.size(); ++k) {
+        visits += (k ? " / " : "") + std::to_string(rc.visits[k]);
+        places += (k ? " / " : "") + std::to_string(rc.places[k]);
+      }
+      t.rows.push_back({std::to_string(rc.room), visits, places});
+    }
+    out.push_back(t);
+  }
+  if (r.topology) {
+    const TopologyScore& s = *r.topology;
+    Table t{"Topology (most probable): nodes vs. rooms", {"measure", "value"}, {}};
+    t.rows.push_back({"nodes", std::to_string(s.nodes)});
+    t.rows.push_back({"rooms with a place", std::to_string(s.rooms)});
+    t.rows.push_back({"nodes matching a room one-to-one", std::to_string(s.one_to_one)});
+    t.rows.push_back({"merged nodes (span >= 2 rooms)", std::to_string(s.merged_nodes)});
+    t.rows.push_back({"split rooms (on >= 2 nodes)", std::to_string(s.split_rooms)});
+    t.rows.push_back({"loop closures", std::to_string(s.loop_closures)});
+    t.rows.push_back({"wrong loop closures", std::to_string(s.wrong_loop_closures)});
+    t.rows.push_back({"missed loop closures", std::to_string(s.missed_loop_closures)});
+    out.push_back(t);
+  }
+  if (!r.best_topology_probability.empty()) {
+    const auto& p = r.best_topology_probability;
+    double mean = 0;
+    for (double v : p) mean += v;
+    mean /= static_cast<double>(p.size());
+    Table t{"Probability of the most probable topology", {"measure", "value"}, {}};
+    t.rows.push_back({"after the last place", fmt("%.3f", p.back())});
+    t.rows.push_back({"mean over places", fmt("%.3f", mean)});
+    t.rows.push_back({"minimum", fmt("%.3f", *std::min_element(p.begin(), p.end()))});
+    out.push_back(t);
+  }
+  return out;
+}
+
+std::string escapeHtml(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string formatEvalText(const EvalResult& r) {
+  std::ostringstream out;
+  out << "run " << r.run_dir << " vs. " << r.truth_kind << " " << r.truth_path << ": " << r.frames
+      << " frames, " << r.places << " places (" << r.dropped_places << " dropped), " << r.traversals
+      << " traversal(s)\n";
+  for (const Table& t : tables(r)) {
+    out << "\n" << t.title << "\n";
+    std::vector<std::size_t> width(t.header.size(), 0);
+    for (std::size_t c = 0; c < t.header.size(); ++c) {
+      width[c] = t.header[c].size();
+      for (const auto& row : t.rows) width[c] = std::max(width[c], row[c].size());
+    }
+    auto line = [&](const std::vector<std::string>& cells) {
+      out << " ";
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        out << " " << std::string(width[c] - cells[c].size(), ' ') << cells[c];
+      }
+      out << "\n";
+    };
+    line(t.header);
+    for (const auto& row : t.rows) line(row);
+  }
+  for (const auto& note : r.notes) out << "\nnote: " << note << "\n";
+  return out.str();
+}
+
+std::string formatEvalHtml(const EvalResult& r) {
+  std::ostringstream out;
+  for (const Table& t : tables(r)) {
+    out << "<h3 class=\"eval\">" << escapeHtml(t.title) << "</h3>\n<table class=\"eval\">\n<tr>";
+    for (const auto& h : t.header) out << "<th>" << escapeHtml(h) << "</th>";
+    out << "</tr>\n";
+    for (const auto& row : t.rows) {
+      out << "<tr>";
+      for (const auto& cell : row) out << "<td>" << escapeHtml(cell) << "</td>";
+      out << "</tr>\n";
+    }
+    out << "</table>\n";
+  }
+  for (const auto& note : r.notes) out << "<p class=\"note\">" << escapeHtml(note) << "</p>\n";
+  return out.str();
+}
+
+}  // namespace toposlam::eval

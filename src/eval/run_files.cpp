@@ -1,0 +1,274 @@
+// Loaders for run-folder files and ground truth (see run_files.hpp). All errors name file and line.
+#include "toposlam/eval/run_files.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "toposlam/eval/json_reader.hpp"
+
+namespace toposlam::eval {
+
+namespace {
+
+std::string trim(const std::string& s) {
+  std::size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
+  return s.substr(b, e - b);
+}
+
+std::vector<std::string> splitComma(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+std::string where(const CsvTable& t, std::size_t row) { return t.path + ":" + std::to_string(t.lines[row]); }
+
+}  // namespace
+
+CsvTable readCsv(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw RunFileError(path + ": cannot open (does the file exist?)");
+  CsvTable table;
+  table.path = path;
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (trim(line).empty()) continue;
+    std::vector<std::string> cells = splitComma(line);
+    if (table.header.empty()) {
+      table.header = std::move(cells);
+      continue;
+    }
+    if (cells.size() < table.header.size()) cells.resize(table.header.size());  // tolerate trailing empties
+    table.rows.push_back(std::move(cells));
+    table.lines.push_back(line_number);
+  }
+  if (table.header.empty()) throw RunFileError(path + ":1: empty file, expected a header line");
+  return table;
+}
+
+int CsvTable::column(const std::string& name, bool required) const {
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (header[i] == name) return static_cast<int>(i);
+  }
+  if (required) {
+    std::string have;
+    for (const auto& h : header) have += (have.empty() ? "" : ",") + h;
+    throw RunFileError(path + ":1: missing column '" + name + "' (header is: " + have + ")");
+  }
+  return -1;
+}
+
+double CsvTable::number(std::size_t row, int col, bool allow_empty) const {
+  const std::string& text = rows[row][static_cast<std::size_t>(col)];
+  if (text.empty()) {
+    if (allow_empty) return std::nan("");
+    throw RunFileError(where(*this, row) + ": column '" + header[static_cast<std::size_t>(col)] +
+                       "' is empty");
+  }
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0') {
+    throw RunFileError(where(*this, row) + ": column '" + header[static_cast<std::size_t>(col)] + "': '" +
+                       text + "' is not a number");
+  }
+  return v;
+}
+
+std::int64_t CsvTable::integer(std::size_t row, int col) const {
+  const double v = number(row, col);
+  if (v != std::floor(v) || std::abs(v) > 9e15) {
+    throw RunFileError(where(*this, row) + ": column '" + header[static_cast<std::size_t>(col)] + "': '" +
+                       rows[row][static_cast<std::size_t>(col)] + "' is not an integer");
+  }
+  return static_cast<std::int64_t>(v);
+}
+
+std::vector<LabelRow> loadLabels(const std::string& path) {
+  const CsvTable t = readCsv(path);
+  const int frame = t.column("frame"), room = t.column("room"), time = t.column("time", false);
+  std::vector<LabelRow> rows;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    LabelRow row;
+    row.frame = t.integer(r, frame);
+    row.room = static_cast<int>(t.integer(r, room));
+    row.time_s = time >= 0 ? t.number(r, time, true) : 0.0;
+    if (row.frame != static_cast<std::int64_t>(rows.size())) {
+      throw RunFileError(where(t, r) + ": frame " + std::to_string(row.frame) + " out of order, expected " +
+                         std::to_string(rows.size()));
+    }
+    if (row.room < -1)
+      throw RunFileError(where(t, r) + ": room " + std::to_string(row.room) + " must be >= -1");
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::vector<FrameRecord> loadFrames(const std::string& path) {
+  const CsvTable t = readCsv(path);
+  const int frame = t.column("frame"), time = t.column("time", false), name = t.column("name", false),
+            lambda2 = t.column("lambda2", false), place = t.column("place"), node = t.column("node", false);
+  std::vector<FrameRecord> rows;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    FrameRecord row;
+    row.frame = t.integer(r, frame);
+    if (row.frame != static_cast<std::int64_t>(rows.size())) {
+      throw RunFileError(where(t, r) + ": frame " + std::to_string(row.frame) + " out of order, expected " +
+                         std::to_string(rows.size()));
+    }
+    if (time >= 0) row.time_s = t.number(r, time, true);
+    if (name >= 0) row.name = t.rows[r][static_cast<std::size_t>(name)];
+    if (lambda2 >= 0) row.lambda2 = t.number(r, lambda2, true);
+    row.place = static_cast<int>(t.integer(r, place));
+    row.node = node >= 0 && !t.rows[r][static_cast<std::size_t>(node)].empty()
+                   ? static_cast<int>(t.integer(r, node))
+                   : -1;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+std::vector<PlaceRecord> loadPlaces(const std::string& path) {
+  const CsvTable t = readCsv(path);
+  const int place = t.column("place"), first = t.column("first"), last = t.column("last"),
+            rep = t.column("representative"), kp = t.column("keypoints", false),
+            node = t.column("node", false);
+  std::vector<PlaceRecord> rows;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    PlaceRecord row;
+    row.place = static_cast<int>(t.integer(r, place));
+    row.first = t.integer(r, first);
+    row.last = t.integer(r, last);
+    row.representative = t.integer(r, rep);
+    if (kp >= 0) row.keypoints = static_cast<int>(t.integer(r, kp));
+    row.node = node >= 0 && !t.rows[r][static_cast<std::size_t>(node)].empty()
+                   ? static_cast<int>(t.integer(r, node))
+                   : -1;
+    if (row.first > row.last || row.representative < row.first || row.representative > row.last) {
+      throw RunFileError(where(t, r) + ": need first <= representative <= last, got " +
+                         std::to_string(row.first) + " <= " + std::to_string(row.representative) +
+                         " <= " + std::to_string(row.last));
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TopologyFile loadTopology(const std::string& path) {
+  const JsonValue root = readJsonFile(path);
+  TopologyFile topo;
+  try {
+    topo.probability = root.at("probability").asNumber("probability");
+    if (const JsonValue* p = root.find("particles"))
+      topo.particles = static_cast<int>(p->asNumber("particles"));
+    for (const JsonValue& n : root.at("nodes").asArray("nodes")) {
+      TopologyNode node;
+      node.id = static_cast<int>(n.at("id").asNumber("nodes[].id"));
+      for (const JsonValue& p : n.at("places").asArray("nodes[].places")) {
+        node.places.push_back(static_cast<int>(p.asNumber("nodes[].places[]")));
+      }
+      if (const JsonValue* reps = n.find("representative_frames")) {
+        for (const JsonValue& f : reps->asArray("nodes[].representative_frames")) {
+          node.representative_frames.push_back(
+              static_cast<std::int64_t>(f.asNumber("nodes[].representative_frames[]")));
+        }
+      }
+      topo.nodes.push_back(std::move(node));
+    }
+    if (const JsonValue* edges = root.find("edges")) {
+      for (const JsonValue& e : edges->asArray("edges")) {
+        TopologyEdge edge;
+        edge.from = static_cast<int>(e.at("from").asNumber("edges[].from"));
+        edge.to = static_cast<int>(e.at("to").asNumber("edges[].to"));
+        if (const JsonValue* c = e.find("count")) edge.count = static_cast<int>(c->asNumber("edges[].count"));
+        topo.edges.push_back(edge);
+      }
+    }
+    if (const JsonValue* history = root.find("history")) {
+      for (const JsonValue& h : history->asArray("history")) {
+        TopologyStep step;
+        step.place = static_cast<int>(h.at("place").asNumber("history[].place"));
+        if (const JsonValue* v = h.find("node")) step.node = static_cast<int>(v->asNumber("history[].node"));
+        if (const JsonValue* v = h.find("probability"))
+          step.probability = v->asNumber("history[].probability");
+        if (const JsonValue* v = h.find("best_topology_probability")) {
+          step.best_topology_probability = v->asNumber("history[].best_topology_probability");
+        }
+        if (const JsonValue* v = h.find("effective_sample_size")) {
+          step.effective_sample_size = v->asNumber("history[].effective_sample_size");
+        }
+        topo.history.push_back(step);
+      }
+    }
+  } catch (const JsonError& e) {
+    throw RunFileError(path + ": " + e.what());
+  }
+  return topo;
+}
+
+std::vector<TimingRow> loadTiming(const std::string& path) {
+  const CsvTable t = readCsv(path);
+  const int frame = t.column("frame"), fp = t.column("fingerprint_ms", false),
+            seg = t.column("segment_ms", false), filt = t.column("filter_ms", false);
+  std::vector<TimingRow> rows;
+  auto get = [&](std::size_t r, int c) {
+    if (c < 0) return 0.0;
+    const double v = t.number(r, c, true);
+    return std::isfinite(v) ? v : 0.0;
+  };
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    rows.push_back(TimingRow{t.integer(r, frame), get(r, fp), get(r, seg), get(r, filt)});
+  }
+  return rows;
+}
+
+LoopClosureMatrix loadLoopClosureImage(const std::string& path) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty())
+    throw RunFileError(path + ": cannot read as an image (expected a BMP/PNG loop-closure matrix)");
+  if (image.rows != image.cols) {
+    throw RunFileError(path + ": loop-closure matrix must be square, got " + std::to_string(image.cols) +
+                       "x" + std::to_string(image.rows));
+  }
+  LoopClosureMatrix m;
+  m.size = image.rows;
+  m.same.assign(static_cast<std::size_t>(m.size) * static_cast<std::size_t>(m.size), 0);
+  for (int i = 0; i < m.size; ++i) {
+    for (int j = 0; j < m.size; ++j) {
+      if (image.at<std::uint8_t>(i, j) != 0) {
+        m.same[static_cast<std::size_t>(i * m.size + j)] = 1;
+        m.same[static_cast<std::size_t>(j * m.size + i)] = 1;
+      }
+    }
+  }
+  return m;
+}
+
+std::vector<NamedPair> loadLoopClosurePairs(const std::string& path) {
+  const CsvTable t = readCsv(path);
+  if (t.header.size() < 2) throw RunFileError(path + ":1: expected two columns: query,matches");
+  std::vector<NamedPair> pairs;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    const std::string& query = t.rows[r][0];
+    if (query.empty()) throw RunFileError(where(t, r) + ": empty query name");
+    // The second column may itself hold several space-separated names; extra columns are more names.
+    for (std::size_t c = 1; c < t.rows[r].size(); ++c) {
+      std::istringstream names(t.rows[r][c]);
+      std::string name;
+      while (names >> name) pairs.push_back(NamedPair{query, name, t.lines[r]});
+    }
+  }
+  return pairs;
+}
+
+}  // namespace toposlam::eval

@@ -1,0 +1,121 @@
+// Brute-force nearest-neighbour kernels for keypoint descriptors: see descriptor_kernels.hpp.
+#include "descriptor_kernels.hpp"
+
+#include <bit>
+#include <cstddef>
+#include <cmath>
+#include <limits>
+
+// Hardware popcount when the build does not already assume it (x86-64 baseline has none): GCC and
+// Clang emit a hardware and a portable clone and pick one through an ifunc resolver at load time.
+#if defined(__x86_64__) && !defined(__POPCNT__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define TOPOSLAM_POPCOUNT_CLONES __attribute__((target_clones("popcnt", "default")))
+#endif
+#endif
+#ifndef TOPOSLAM_POPCOUNT_CLONES
+#define TOPOSLAM_POPCOUNT_CLONES
+#endif
+
+namespace toposlam::detail {
+namespace {
+
+// Updates (best, second, index) with one candidate distance. Ties keep the earlier row.
+template <typename Distance>
+[[gnu::always_inline]] inline void consider(Distance distance, int row, Distance& best, Distance& second,
+                                            int& best_row) {
+  if (distance < best) {
+    second = best;
+    best = distance;
+    best_row = row;
+  } else if (distance < second) {
+    second = distance;
+  }
+}
+
+template <int kWords>
+[[gnu::always_inline]] inline void scanFixed(const std::uint64_t* query, int query_count,
+                                             const std::uint64_t* reference, int reference_count,
+                                             DescriptorMatch* out) {
+  for (int q = 0; q < query_count; ++q) {
+    const std::uint64_t* qrow = query + static_cast<std::ptrdiff_t>(q) * kWords;
+    int best = std::numeric_limits<int>::max();
+    int second = std::numeric_limits<int>::max();
+    int best_row = -1;
+    for (int r = 0; r < reference_count; ++r) {
+      const std::uint64_t* rrow = reference + static_cast<std::ptrdiff_t>(r) * kWords;
+      int distance = 0;
+      for (int w = 0; w < kWords; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
+      consider(distance, r, best, second, best_row);
+    }
+    out[q].reference_keypoint = best_row;
+    out[q].distance = static_cast<float>(best);
+    out[q].second_distance = second == std::numeric_limits<int>::max()
+                                 ? std::numeric_limits<float>::infinity()
+                                 : static_cast<float>(second);
+  }
+}
+
+[[gnu::always_inline]] inline void scanAny(const std::uint64_t* query, int query_count,
+                                           const std::uint64_t* reference, int reference_count, int words,
+                                           DescriptorMatch* out) {
+  for (int q = 0; q < query_count; ++q) {
+    const std::uint64_t* qrow = query + static_cast<std::ptrdiff_t>(q) * words;
+    int best = std::numeric_limits<int>::max();
+    int second = std::numeric_limits<int>::max();
+    int best_row = -1;
+    for (int r = 0; r < reference_count; ++r) {
+      const std::uint64_t* rrow = reference + static_cast<std::ptrdiff_t>(r) * words;
+      int distance = 0;
+      for (int w = 0; w < words; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
+      consider(distance, r, best, second, best_row);
+    }
+    out[q].reference_keypoint = best_row;
+    out[q].distance = static_cast<float>(best);
+    out[q].second_distance = second == std::numeric_limits<int>::max()
+                                 ? std::numeric_limits<float>::infinity()
+                                 : static_cast<float>(second);
+  }
+}
+
+}  // namespace
+
+TOPOSLAM_POPCOUNT_CLONES
+void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
+                       int reference_count, int words, DescriptorMatch* out) {
+  switch (words) {
+    case 4:  // ORB, 32 bytes
+      scanFixed<4>(query, query_count, reference, reference_count, out);
+      break;
+    case 8:  // BRISK (64 bytes), AKAZE-MLDB (61 bytes, padded)
+      scanFixed<8>(query, query_count, reference, reference_count, out);
+      break;
+    default:
+      scanAny(query, query_count, reference, reference_count, words, out);
+      break;
+  }
+}
+
+void bestFloatMatches(const float* query, int query_count, int query_stride, const float* reference,
+                      int reference_count, int reference_stride, int dims, DescriptorMatch* out) {
+  for (int q = 0; q < query_count; ++q) {
+    const float* qrow = query + static_cast<std::ptrdiff_t>(q) * query_stride;
+    float best = std::numeric_limits<float>::infinity();
+    float second = std::numeric_limits<float>::infinity();
+    int best_row = -1;
+    for (int r = 0; r < reference_count; ++r) {
+      const float* rrow = reference + static_cast<std::ptrdiff_t>(r) * reference_stride;
+      float squared = 0.f;
+      for (int d = 0; d < dims; ++d) {
+        const float difference = qrow[d] - rrow[d];
+        squared += difference * difference;
+      }
+      consider(squared, r, best, second, best_row);
+    }
+    out[q].reference_keypoint = best_row;
+    out[q].distance = std::sqrt(best);
+    out[q].second_distance = std::sqrt(second);
+  }
+}
+
+}  // namespace toposlam::detail

@@ -1,0 +1,24 @@
+// Brute-force nearest-neighbour kernels for keypoint descriptors (private to toposlam_matching).
+// Binary descriptors are packed into whole 64-bit words (zero padded) so the Hamming distance is a few
+// XOR + popcount per pair; on x86-64 without -mpopcnt the kernel is compiled twice (hardware popcount
+// and a portable fallback) and chosen once at load time. Float descriptors use squared L2.
+//
+// Thread-safety: pure functions.
+#pragma once
+
+#include <cstdint>
+
+#include "toposlam/matching/ngram_matcher.hpp"
+
+namespace toposlam::detail {
+
+/// For each of query_count query rows (each `words` 64-bit words), the best and second best reference
+/// rows by Hamming distance. out[q].reference_keypoint = -1 when reference_count == 0.
+void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
+                       int reference_count, int words, DescriptorMatch* out);
+
+/// Same for float rows of `dims` values (row strides in floats); distances are L2 (not squared).
+void bestFloatMatches(const float* query, int query_count, int query_stride, const float* reference,
+                      int reference_count, int reference_stride, int dims, DescriptorMatch* out);
+
+}  // namespace toposlam::detail

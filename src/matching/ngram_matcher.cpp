@@ -1,0 +1,297 @@
+// n-gram matching of two VPACK fingerprints (thesis section 3.3.1): see ngram_matcher.hpp.
+#include "toposlam/matching/ngram_matcher.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstddef>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include "descriptor_kernels.hpp"
+
+namespace toposlam {
+namespace {
+
+MatchScratch& threadScratch() {
+  thread_local MatchScratch scratch;
+  return scratch;
+}
+
+// Grows a buffer without shrinking it, so a warm scratch never allocates again.
+template <typename T>
+void resizeFor(std::vector<T>& buffer, std::size_t size, const T& value) {
+  if (buffer.capacity() < size) buffer.reserve(std::max(size, 2 * buffer.capacity()));
+  buffer.assign(size, value);
+}
+
+// sqrt(bin / sum) per bin, so rho(Q, R) is a plain dot product. Returns false for an empty histogram.
+bool sqrtHistogram(const HclHistogramBins& bins, double* out) {
+  double sum = 0.0;
+  for (float value : bins) sum += std::max(0.f, value);
+  if (!(sum > 0.0)) {
+    std::fill(out, out + kHistogramBins, 0.0);
+    return false;
+  }
+  for (int b = 0; b < kHistogramBins; ++b) out[b] = std::sqrt(std::max(0.f, bins[b]) / sum);
+  return true;
+}
+
+double hellingerFromSqrt(const double* a, bool a_empty, const double* b, bool b_empty) {
+  if (a_empty || b_empty) return a_empty && b_empty ? 0.0 : 1.0;
+  double rho = 0.0;
+  for (int k = 0; k < kHistogramBins; ++k) rho += a[k] * b[k];
+  return std::sqrt(std::clamp(1.0 - rho, 0.0, 1.0));
+}
+
+// Descriptor rows usable for matching: one channel, CV_8U or CV_32F, at least one row and column.
+bool hasDescriptors(const Fingerprint& f) {
+  return !f.descriptors.empty() && f.descriptors.channels() == 1 &&
+         (f.descriptors.depth() == CV_8U || f.descriptors.depth() == CV_32F);
+}
+
+// Copies binary rows into zero-padded 64-bit words (words per row = ceil(bytes / 8)).
+void packBinaryRows(const cv::Mat& rows, int words, std::vector<std::uint64_t>& out) {
+  resizeFor(out, static_cast<std::size_t>(rows.rows) * static_cast<std::size_t>(words), std::uint64_t{0});
+  const std::size_t bytes = static_cast<std::size_t>(rows.cols);
+  for (int r = 0; r < rows.rows; ++r) {
+    std::memcpy(out.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(words), rows.ptr<std::uint8_t>(r),
+                bytes);
+  }
+}
+
+// Clamped keypoint range of a subregion against the descriptor matrix (defensive: validate() should
+// already guarantee it).
+void keypointRange(const Subregion& s, int rows, int& begin, int& end) {
+  begin = std::clamp(s.keypoint_begin, 0, rows);
+  end = std::clamp(s.keypoint_end, begin, rows);
+}
+
+}  // namespace
+
+std::string NgramMatcherConfig::validate() const {
+  if (!(max_hellinger_distance > 0.0 && max_hellinger_distance <= 1.0))
+    return "max_hellinger_distance: must be in (0, 1] (thesis: 0.3)";
+  if (!(max_binary_distance_fraction > 0.0 && max_binary_distance_fraction <= 1.0))
+    return "max_binary_distance_fraction: must be in (0, 1] (1 disables the test)";
+  if (!(max_float_distance >= 0.0) || !std::isfinite(max_float_distance))
+    return "max_float_distance: must be >= 0 (0 disables the test)";
+  if (!(ratio_test > 0.0 && ratio_test <= 1.0)) return "ratio_test: must be in (0, 1] (1 disables the test)";
+  return "";
+}
+
+NgramMatcher::NgramMatcher(const NgramMatcherConfig& config) : config_(config) {
+  const std::string problem = config_.validate();
+  if (!problem.empty()) throw std::invalid_argument("matching config: " + problem);
+}
+
+double NgramMatcher::hellingerDistance(const HclHistogramBins& a, const HclHistogramBins& b) {
+  double sa[kHistogramBins];
+  double sb[kHistogramBins];
+  const bool a_full = sqrtHistogram(a, sa);
+  const bool b_full = sqrtHistogram(b, sb);
+  return hellingerFromSqrt(sa, !a_full, sb, !b_full);
+}
+
+int NgramMatcher::hammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
+  int distance = 0;
+  int i = 0;
+  for (; i + 8 <= bytes; i += 8) {
+    std::uint64_t wa = 0;
+    std::uint64_t wb = 0;
+    std::memcpy(&wa, a + i, 8);
+    std::memcpy(&wb, b + i, 8);
+    distance += std::popcount(wa ^ wb);
+  }
+  for (; i < bytes; ++i) distance += std::popcount(static_cast<unsigned>(a[i] ^ b[i]));
+  return distance;
+}
+
+double NgramMatcher::countNgrams(const float* scores, int reference_letters, int query_letters, int n,
+                                 int* matched) {
+  double total = 0.0;
+  int found = 0;
+  for (int j = 0; j + n <= reference_letters; ++j) {
+    double best = -1.0;
+    for (int i = 0; i + n <= query_letters; ++i) {
+      double sum = 0.0;
+      bool complete = true;
+      for (int t = 0; t < n; ++t) {
+        const float score = scores[static_cast<std::ptrdiff_t>(j + t) * query_letters + (i + t)];
+        if (!(score > 0.f)) {
+          complete = false;
+          break;
+        }
+        sum += score;
+      }
+      if (complete) best = std::max(best, sum / n);
+    }
+    if (best >= 0.0) {
+      total += best;
+      ++found;
+    }
+  }
+  if (matched != nullptr) *matched = found;
+  return total;
+}
+
+void NgramMatcher::matchHistograms(const Fingerprint& reference, const Fingerprint& query,
+                                   MatchScratch& s) const {
+  const int m = static_cast<int>(reference.subregions.size());
+  const int q = static_cast<int>(query.subregions.size());
+  resizeFor(s.histogram_scores, static_cast<std::size_t>(m) * static_cast<std::size_t>(q), 0.f);
+  if (m == 0 || q == 0) return;
+  resizeFor(s.reference_sqrt_histograms, static_cast<std::size_t>(m) * kHistogramBins, 0.0);
+  resizeFor(s.query_sqrt_histograms, static_cast<std::size_t>(q) * kHistogramBins, 0.0);
+  resizeFor(s.reference_histogram_empty, static_cast<std::size_t>(m), std::uint8_t{0});
+  resizeFor(s.query_histogram_empty, static_cast<std::size_t>(q), std::uint8_t{0});
+  for (int j = 0; j < m; ++j) {
+    s.reference_histogram_empty[j] =
+        sqrtHistogram(reference.subregions[j].histogram, &s.reference_sqrt_histograms[j * kHistogramBins]) ? 0 : 1;
+  }
+  for (int i = 0; i < q; ++i) {
+    s.query_histogram_empty[i] =
+        sqrtHistogram(query.subregions[i].histogram, &s.query_sqrt_histograms[i * kHistogramBins]) ? 0 : 1;
+  }
+  // For every reference histogram, its best query histogram (ties: the leftmost), if close enough.
+  for (int j = 0; j < m; ++j) {
+    double best = std::numeric_limits<double>::infinity();
+    int best_letter = -1;
+    for (int i = 0; i < q; ++i) {
+      const double d = hellingerFromSqrt(&s.reference_sqrt_histograms[j * kHistogramBins],
+                                         s.reference_histogram_empty[j] != 0,
+                                         &s.query_sqrt_histograms[i * kHistogramBins], s.query_histogram_empty[i] != 0);
+      if (d < best) {
+        best = d;
+        best_letter = i;
+      }
+    }
+    if (best_letter >= 0 && best <= config_.max_hellinger_distance) {
+      s.histogram_scores[static_cast<std::size_t>(j) * q + best_letter] = static_cast<float>(1.0 - best);
+    }
+  }
+}
+
+int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint& query,
+                                 MatchScratch& s) const {
+  const int m = static_cast<int>(reference.subregions.size());
+  const int q = static_cast<int>(query.subregions.size());
+  const std::size_t cells = static_cast<std::size_t>(m) * static_cast<std::size_t>(q);
+  resizeFor(s.keypoint_scores, cells, 0.f);
+  if (m == 0 || q == 0 || !hasDescriptors(reference) || !hasDescriptors(query)) return 0;
+  const cv::Mat& rd = reference.descriptors;
+  const cv::Mat& qd = query.descriptors;
+  if (rd.type() != qd.type() || rd.cols != qd.cols) return 0;  // different backends: nothing comparable
+
+  resizeFor(s.matches, static_cast<std::size_t>(qd.rows), DescriptorMatch{});
+  double max_distance = std::numeric_limits<double>::infinity();
+  if (rd.depth() == CV_8U) {
+    const int words = (rd.cols + 7) / 8;
+    packBinaryRows(rd, words, s.reference_words);
+    packBinaryRows(qd, words, s.query_words);
+    detail::bestBinaryMatches(s.query_words.data(), qd.rows, s.reference_words.data(), rd.rows, words,
+                              s.matches.data());
+    if (config_.max_binary_distance_fraction < 1.0) max_distance = config_.max_binary_distance_fraction * 8.0 * rd.cols;
+  } else {
+    // cv::Mat rows may be padded: pass strides in floats (step is a multiple of 4 for CV_32F).
+    const int query_stride = static_cast<int>(qd.step1());
+    const int reference_stride = static_cast<int>(rd.step1());
+    detail::bestFloatMatches(qd.ptr<float>(0), qd.rows, query_stride, rd.ptr<float>(0), rd.rows,
+                             reference_stride, rd.cols, s.matches.data());
+    if (config_.max_float_distance > 0.0) max_distance = config_.max_float_distance;
+  }
+
+  resizeFor(s.reference_letter_of_keypoint, static_cast<std::size_t>(rd.rows), -1);
+  for (int j = 0; j < m; ++j) {
+    int begin = 0;
+    int end = 0;
+    keypointRange(reference.subregions[j], rd.rows, begin, end);
+    for (int k = begin; k < end; ++k) s.reference_letter_of_keypoint[k] = j;
+  }
+  resizeFor(s.last_query_letter, static_cast<std::size_t>(rd.rows), -1);
+  resizeFor(s.pair_matches, cells, 0);
+
+  int kept = 0;
+  for (int i = 0; i < q; ++i) {
+    int begin = 0;
+    int end = 0;
+    keypointRange(query.subregions[i], qd.rows, begin, end);
+    for (int k = begin; k < end; ++k) {
+      const DescriptorMatch& match = s.matches[k];
+      if (match.reference_keypoint < 0) continue;
+      if (!(match.distance <= max_distance)) continue;
+      if (config_.ratio_test < 1.0 &&
+          !(static_cast<double>(match.distance) <= config_.ratio_test * match.second_distance))
+        continue;
+      ++kept;
+      const int r = match.reference_keypoint;
+      const int j = s.reference_letter_of_keypoint[r];
+      if (j < 0 || s.last_query_letter[r] == i) continue;  // count each reference keypoint once per pair
+      s.last_query_letter[r] = i;
+      ++s.pair_matches[static_cast<std::size_t>(j) * q + i];
+    }
+  }
+  for (int j = 0; j < m; ++j) {
+    const int own = reference.subregions[j].keypointCount();
+    if (own <= 0) continue;
+    for (int i = 0; i < q; ++i) {
+      const int matched = s.pair_matches[static_cast<std::size_t>(j) * q + i];
+      if (matched > 0) {
+        s.keypoint_scores[static_cast<std::size_t>(j) * q + i] =
+            static_cast<float>(std::min(1.0, static_cast<double>(matched) / own));
+      }
+    }
+  }
+  return kept;
+}
+
+NgramCounts NgramMatcher::counts(const Fingerprint& reference, const Fingerprint& query,
+                                 MatchScratch* scratch) const {
+  MatchScratch& s = scratch != nullptr ? *scratch : threadScratch();
+  NgramCounts result;
+  const int m = static_cast<int>(reference.subregions.size());
+  const int q = static_cast<int>(query.subregions.size());
+  result.query_keypoints = hasDescriptors(query) ? query.descriptors.rows : 0;
+
+  matchHistograms(reference, query, s);
+  result.matched_keypoints = matchKeypoints(reference, query, s);
+
+  const bool reference_has_keypoints = hasDescriptors(reference);
+  for (int n = 1; n <= kMaxNgramOrder; ++n) {
+    result.histogram_possible[n - 1] = std::max(0, m - n + 1);
+    // Keypoint n-grams are only possible over reference letters that own keypoints.
+    int possible = 0;
+    int run = 0;
+    for (int j = 0; j < m && reference_has_keypoints; ++j) {
+      run = reference.subregions[j].keypointCount() > 0 ? run + 1 : 0;
+      if (run >= n) ++possible;
+    }
+    result.keypoint_possible[n - 1] = possible;
+    if (m == 0 || q == 0) continue;
+    result.histogram[n - 1] = countNgrams(s.histogram_scores.data(), m, q, n, &result.histogram_matched[n - 1]);
+    result.keypoint[n - 1] = countNgrams(s.keypoint_scores.data(), m, q, n, &result.keypoint_matched[n - 1]);
+  }
+  return result;
+}
+
+LetterCorrespondences NgramMatcher::correspondences(const Fingerprint& reference,
+                                                    const Fingerprint& query) const {
+  MatchScratch s;
+  matchHistograms(reference, query, s);
+  matchKeypoints(reference, query, s);
+  LetterCorrespondences result;
+  const int m = static_cast<int>(reference.subregions.size());
+  const int q = static_cast<int>(query.subregions.size());
+  for (int j = 0; j < m; ++j) {
+    for (int i = 0; i < q; ++i) {
+      const std::size_t cell = static_cast<std::size_t>(j) * q + i;
+      if (s.histogram_scores[cell] > 0.f) result.histogram.push_back({j, i, s.histogram_scores[cell], 0});
+      if (s.keypoint_scores[cell] > 0.f)
+        result.keypoint.push_back({j, i, s.keypoint_scores[cell], s.pair_matches[cell]});
+    }
+  }
+  return result;
+}
+
+}  // namespace toposlam

@@ -1,0 +1,144 @@
+// Adapters from the pipeline's stage interfaces to the algorithm classes; see the header.
+#include "toposlam/pipeline/algorithm_stages.hpp"
+
+#include <algorithm>
+#include <map>
+#include <sstream>
+
+#include "toposlam/topology/map_store.hpp"
+
+namespace toposlam {
+
+FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
+                                                   const SimilarityMeasure& similarity, std::size_t max_thumbnails)
+    : segmenter_(config, similarity), max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)) {}
+
+SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
+                                                   const cv::Mat& thumbnail) {
+  thumbnails_.emplace(sequence, thumbnail);
+  if (thumbnails_.size() > max_thumbnails_) thumbnails_.erase(thumbnails_.begin());
+  // The segmenter is independent of time; the frame number stands in for it.
+  SegmenterStep step = segmenter_.addFrame(sequence, static_cast<double>(sequence), std::move(fingerprint));
+  SegmentationStep out;
+  if (step.lambda2) out.lambda2 = *step.lambda2;
+  if (step.closed_place) {
+    const SegmentedPlace& p = *step.closed_place;
+    if (p.dropped) {
+      ++dropped_places_;
+    } else {
+      ClosedPlace place;
+      place.place = static_cast<int>(p.index);
+      place.first_frame = p.first_frame;
+      place.last_frame = p.last_frame;
+      place.representative_frame = p.representative_frame;
+      place.keypoints = p.representative_keypoints;
+      place.representative = p.representative;
+      if (auto it = thumbnails_.find(p.representative_frame); it != thumbnails_.end()) place.thumbnail = it->second;
+      out.closed = std::move(place);
+    }
+    // Frames up to the closed place's end are no longer needed.
+    thumbnails_.erase(thumbnails_.begin(), thumbnails_.upper_bound(p.last_frame));
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+ParticleFilterTopologyStage::ParticleFilterTopologyStage(const TopologyFilterConfig& config,
+                                                         const SimilarityMeasure& similarity, const Clock& clock,
+                                                         int slice_items, int alternatives)
+    : similarity_(similarity),
+      clock_(clock),
+      slice_items_(static_cast<std::size_t>(std::max(1, slice_items))),
+      alternatives_(std::max(0, alternatives)),
+      filter_(std::make_unique<TopologyParticleFilter>(config, similarity)) {
+  topology_.particles = config.particles;
+}
+
+ParticleFilterTopologyStage::~ParticleFilterTopologyStage() = default;
+
+void ParticleFilterTopologyStage::loadMap(const std::string& path) {
+  LoadedMap loaded = MapStore::load(path, similarity_);
+  filter_ = std::move(loaded.filter);
+  // The application data lists the representative frames of the run that saved the map; frame numbers of
+  // an older run mean nothing in this one, so resumed observations show -1.
+  representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);
+  revision_ = 1;
+  refresh();
+}
+
+void ParticleFilterTopologyStage::enqueuePlace(const ClosedPlace& place) {
+  queue_.push_back(place.representative);
+  queued_frames_.push_back(place.representative_frame);
+}
+
+std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budget_s) {
+  const double deadline = clock_.now() + budget_s;
+  do {
+    if (!filter_->stepInProgress()) {
+      if (queue_.empty()) return std::nullopt;
+      filter_->beginStep(queue_.front());
+      queue_.pop_front();
+    }
+    if (filter_->advance(slice_items_)) {
+      representative_frames_.push_back(queued_frames_.front());
+      queued_frames_.pop_front();
+      ++revision_;
+      refresh();
+      PlaceAssignment a;
+      a.place = estimate_.place;
+      a.node = estimate_.node;
+      a.is_new = estimate_.is_new;
+      a.probability = estimate_.probability;
+      return a;
+    }
+  } while (clock_.now() < deadline);
+  return std::nullopt;
+}
+
+void ParticleFilterTopologyStage::refresh() {
+  const int observations = filter_->observationCount();
+  PlaceEstimate e;
+  e.map_revision = revision_;
+  TopologySnapshot t;
+  t.map_revision = revision_;
+  t.particles = filter_->config().particles;
+  if (observations > 0) {
+    const TopologyEstimate te = filter_->estimate(alternatives_ + 1);
+    const std::vector<int>& assignment = te.best.assignment;
+    e.place = observations - 1;
+    e.node = te.current_node;
+    e.probability = te.current_node_probability;
+    e.is_new = !assignment.empty() &&
+               std::find(assignment.begin(), assignment.end() - 1, assignment.back()) == assignment.end() - 1;
+    for (const LocationHypothesis& h : te.locations) {
+      if (static_cast<int>(e.alternatives.size()) >= alternatives_) break;
+      if (h.node_in_best == e.node && h.node_in_best >= 0) continue;  // the estimate itself
+      e.alternatives.push_back({h.node_in_best, h.probability});
+    }
+    t.probability = te.best.probability;
+    t.nodes.resize(static_cast<std::size_t>(te.best.node_count));
+    for (int i = 0; i < te.best.node_count; ++i) t.nodes[static_cast<std::size_t>(i)].id = i;
+    std::map<std::pair<int, int>, int> edges;
+    for (std::size_t k = 0; k < assignment.size(); ++k) {
+      const int node = assignment[k];
+      if (node < 0 || node >= te.best.node_count) continue;
+      TopologyNode& n = t.nodes[static_cast<std::size_t>(node)];
+      n.places.push_back(static_cast<int>(k));
+      n.representative_frames.push_back(k < representative_frames_.size() ? representative_frames_[k] : -1);
+      if (k > 0 && assignment[k - 1] != node) ++edges[{assignment[k - 1], node}];
+    }
+    for (const auto& [ends, count] : edges) t.edges.push_back({ends.first, ends.second, count});
+  }
+  estimate_ = std::move(e);
+  topology_ = std::move(t);
+}
+
+void ParticleFilterTopologyStage::saveMap(const std::string& path) const {
+  std::ostringstream data;
+  data << "toposlamd-frames";
+  for (std::int64_t f : representative_frames_) data << ' ' << f;
+  MapStore::save(path, *filter_, data.str());
+}
+
+}  // namespace toposlam

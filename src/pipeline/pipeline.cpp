@@ -1,0 +1,446 @@
+// Pipeline: the five stage threads and the queues between them; see the header for the shape.
+#include "toposlam/pipeline/pipeline.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+namespace toposlam {
+
+namespace {
+
+constexpr std::chrono::milliseconds kPollPeriod{100};  // how often an idle thread wakes to beat
+const char* const kStageNames[] = {"capture", "fingerprint", "segmentation", "topology", "publisher"};
+
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+std::string rangeError(const std::string& key, double value, const char* range) {
+  return key + ": " + std::to_string(value) + " is out of range, allowed " + range;
+}
+
+}  // namespace
+
+const char* toString(QueueOverflow overflow) {
+  return overflow == QueueOverflow::Block ? "block" : "drop_oldest";
+}
+
+std::string PipelineConfig::validate() const {
+  const std::pair<const char*, int> capacities[] = {{"queues.frames", queues.frames},
+                                                     {"queues.fingerprints", queues.fingerprints},
+                                                     {"queues.segmented", queues.segmented},
+                                                     {"queues.results", queues.results}};
+  for (const auto& [key, capacity] : capacities)
+    if (capacity < 1 || capacity > 1024) return rangeError(key, capacity, "1 .. 1024");
+  const std::pair<const char*, const ThreadSettings*> thread_table[] = {
+      {"threads.capture", &this->threads.capture},       {"threads.fingerprint", &this->threads.fingerprint},
+      {"threads.segmentation", &this->threads.segmentation}, {"threads.topology", &this->threads.topology},
+      {"threads.publisher", &this->threads.publisher}};
+  for (const auto& [key, settings] : thread_table)
+    if (std::string problem = settings->validate(); !problem.empty()) return std::string(key) + "." + problem;
+  if (!(filter_budget_ms >= 0.1 && filter_budget_ms <= 1000.0))
+    return rangeError("filter_budget_ms", filter_budget_ms, "0.1 .. 1000 (milliseconds)");
+  if (!(status_period_s >= 0.1 && status_period_s <= 60.0))
+    return rangeError("status_period_s", status_period_s, "0.1 .. 60 (seconds)");
+  if (thumbnail_width < 16 || thumbnail_width > 1280)
+    return rangeError("thumbnail_width", thumbnail_width, "16 .. 1280 (pixels)");
+  if (!(map_save_period_s == 0.0 || (map_save_period_s >= 1.0 && map_save_period_s <= 86400.0)))
+    return rangeError("map_save_period_s", map_save_period_s, "0 (only at stop) or 1 .. 86400 (seconds)");
+  if (!(heartbeat_timeout_s >= 0.5 && heartbeat_timeout_s <= 600.0))
+    return rangeError("heartbeat_timeout_s", heartbeat_timeout_s, "0.5 .. 600 (seconds)");
+  return "";
+}
+
+LatencyStats summarizeLatencies(std::vector<double>& values_ms) {
+  LatencyStats stats;
+  stats.samples = static_cast<std::int64_t>(values_ms.size());
+  if (values_ms.empty()) return stats;
+  const std::size_t n = values_ms.size();
+  auto at_rank = [&](std::size_t rank) {  // rank-th smallest, from 0
+    std::nth_element(values_ms.begin(), values_ms.begin() + static_cast<std::ptrdiff_t>(rank), values_ms.end());
+    return values_ms[rank];
+  };
+  const std::size_t p99_rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(n))) - 1;
+  stats.max_ms = *std::max_element(values_ms.begin(), values_ms.end());
+  stats.p99_ms = at_rank(p99_rank);
+  if (n % 2 == 1) {
+    stats.median_ms = at_rank(n / 2);
+  } else {
+    const double upper = at_rank(n / 2);
+    const double lower = *std::max_element(values_ms.begin(), values_ms.begin() + static_cast<std::ptrdiff_t>(n / 2));
+    stats.median_ms = 0.5 * (lower + upper);
+  }
+  return stats;
+}
+
+struct Pipeline::CapturedFrame {
+  Frame frame;
+  double captured_at_s = 0.0;
+};
+
+struct Pipeline::Fingerprinted {
+  FrameResult result;
+  std::shared_ptr<const Fingerprint> fingerprint;
+  cv::Mat thumbnail;
+};
+
+Pipeline::Pipeline(const PipelineConfig& config, FrameSource& source, FingerprintStage& fingerprint,
+                   SegmentationStage& segmentation, TopologyStage& topology, PipelineSink& sink, const Clock& clock)
+    : config_(config),
+      source_(source),
+      fingerprint_(fingerprint),
+      segmentation_(segmentation),
+      topology_(topology),
+      sink_(sink),
+      clock_(clock) {
+  if (std::string problem = config_.validate(); !problem.empty())
+    throw std::invalid_argument("pipeline." + problem);
+  frames_ = std::make_unique<BoundedQueue<CapturedFrame>>(static_cast<std::size_t>(config_.queues.frames));
+  fingerprints_ = std::make_unique<BoundedQueue<Fingerprinted>>(static_cast<std::size_t>(config_.queues.fingerprints));
+  segmented_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.segmented));
+  results_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.results));
+  status_.state = "created";
+}
+
+Pipeline::~Pipeline() {
+  requestStop();
+  wait();
+}
+
+void Pipeline::start() {
+  if (started_.exchange(true)) throw std::logic_error("Pipeline::start() called twice");
+  start_time_s_ = clock_.now();
+  for (auto& h : heartbeat_) h.store(start_time_s_);
+  if (config_.record_latencies) latencies_ms_.reserve(1 << 16);
+  {
+    std::lock_guard lock(status_mutex_);
+    status_.state = "running";
+  }
+  // Started from the end of the chain so every consumer is waiting before its producer runs.
+  threads_.start(config_.threads.publisher, [this] { publisherLoop(); });
+  threads_.start(config_.threads.topology, [this] { topologyLoop(); });
+  threads_.start(config_.threads.segmentation, [this] { segmentationLoop(); });
+  threads_.start(config_.threads.fingerprint, [this] { fingerprintLoop(); });
+  threads_.start(config_.threads.capture, [this] { captureLoop(); });
+}
+
+void Pipeline::requestStop() { stop_requested_.store(true); }
+
+void Pipeline::wait() { threads_.joinAll(); }
+
+bool Pipeline::healthy() const {
+  const double now = clock_.now();
+  for (int i = 0; i < kThreadCount; ++i)
+    if (!thread_done_[i].load() && now - heartbeat_[i].load() > config_.heartbeat_timeout_s) return false;
+  return error().empty();
+}
+
+PipelineStatus Pipeline::status() const {
+  std::lock_guard lock(status_mutex_);
+  return status_;
+}
+
+std::string Pipeline::error() const {
+  std::lock_guard lock(status_mutex_);
+  return error_;
+}
+
+void Pipeline::recordError(const std::string& what) {
+  spdlog::error("pipeline: {}", what);
+  std::lock_guard lock(status_mutex_);
+  if (error_.empty()) error_ = what;
+}
+
+void Pipeline::beat(StageIndex stage) {
+  heartbeat_[stage].store(clock_.now());
+  thread_cpu_s_[stage].store(threadCpuSeconds());
+}
+
+template <typename Q, typename T>
+bool Pipeline::forward(Q& queue, T&& item) {
+  if (config_.queues.overflow == QueueOverflow::Block) return queue.pushWait(std::forward<T>(item));
+  return queue.push(std::forward<T>(item));
+}
+
+void Pipeline::captureLoop() {
+  try {
+    while (!stop_requested_.load()) {
+      std::optional<Frame> frame = source_.next();
+      source_skipped_.store(source_.skippedFrames());
+      beat(kCapture);
+      if (!frame) break;
+      CapturedFrame captured{std::move(*frame), clock_.now()};
+      if (!forward(*frames_, std::move(captured))) break;  // downstream ended
+      processed_[kCapture].fetch_add(1);
+    }
+  } catch (const std::exception& e) {
+    recordError(std::string("capture: ") + e.what());
+  }
+  frames_->close();
+  thread_done_[kCapture].store(true);
+  finished_threads_.fetch_add(1);
+}
+
+void Pipeline::fingerprintLoop() {
+  std::int64_t failures = 0;
+  try {
+    for (;;) {
+      CapturedFrame captured;
+      QueueWait wait = frames_->popFor(captured, kPollPeriod);
+      beat(kFingerprint);
+      if (wait == QueueWait::Closed) break;
+      if (wait == QueueWait::Timeout) continue;
+      const double t0 = clock_.now();
+      Fingerprinted out;
+      try {
+        out.fingerprint = std::make_shared<const Fingerprint>(fingerprint_.process(captured.frame.image));
+        const cv::Mat& image = captured.frame.image;
+        const int width = std::min(config_.thumbnail_width, image.cols);
+        const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
+        cv::resize(image, out.thumbnail, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+      } catch (const std::exception& e) {
+        // A bad frame from the world: counted, logged now and then, survived.
+        if (failures++ % 100 == 0) spdlog::warn("fingerprint: frame {} skipped ({} so far): {}", captured.frame.sequence, failures, e.what());
+        continue;
+      }
+      FrameResult& r = out.result;
+      r.sequence = captured.frame.sequence;
+      r.source_time_s = captured.frame.timestamp_s;
+      r.captured_at_s = captured.captured_at_s;
+      r.name = std::move(captured.frame.name);
+      r.keypoints = out.fingerprint->keypointCount();
+      captured = CapturedFrame{};  // hands the buffer back to the source before we queue anything
+      r.fingerprint_ms = (clock_.now() - t0) * 1e3;
+      if (!forward(*fingerprints_, std::move(out))) break;
+      processed_[kFingerprint].fetch_add(1);
+    }
+  } catch (const std::exception& e) {
+    recordError(std::string("fingerprint: ") + e.what());
+  }
+  frames_->close();  // a dead consumer must not leave the producer blocked
+  fingerprints_->close();
+  thread_done_[kFingerprint].store(true);
+  finished_threads_.fetch_add(1);
+}
+
+void Pipeline::segmentationLoop() {
+  try {
+    for (;;) {
+      Fingerprinted in;
+      QueueWait wait = fingerprints_->popFor(in, kPollPeriod);
+      beat(kSegmentation);
+      if (wait == QueueWait::Closed) break;
+      if (wait == QueueWait::Timeout) continue;
+      const double t0 = clock_.now();
+      SegmentationStep step = segmentation_.process(in.result.sequence, std::move(in.fingerprint), in.thumbnail);
+      in.result.lambda2 = step.lambda2;
+      if (step.closed) in.result.closed_place = std::move(step.closed);
+      in.result.segmentation_ms = (clock_.now() - t0) * 1e3;
+      if (!forward(*segmented_, std::move(in.result))) break;
+      processed_[kSegmentation].fetch_add(1);
+    }
+  } catch (const std::exception& e) {
+    recordError(std::string("segmentation: ") + e.what());
+  }
+  fingerprints_->close();
+  segmented_->close();
+  thread_done_[kSegmentation].store(true);
+  finished_threads_.fetch_add(1);
+}
+
+void Pipeline::saveMap() {
+  if (config_.map_path.empty()) return;
+  topology_.saveMap(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
+  maps_saved_.fetch_add(1);
+  spdlog::info("pipeline: map saved to {}", config_.map_path);
+}
+
+void Pipeline::topologyLoop() {
+  std::deque<ClosedPlace> pending;  // places whose step is queued or in progress, oldest first
+  std::int64_t published_revision = -1;
+  double next_save_s = clock_.now() + (config_.map_save_period_s > 0 ? config_.map_save_period_s : 0.0);
+  const double budget_s = config_.filter_budget_ms * 1e-3;
+
+  auto attach = [&](FrameResult& r, const PlaceAssignment& assignment) {
+    ClosedPlace place;
+    if (!pending.empty()) {
+      place = std::move(pending.front());
+      pending.pop_front();
+    }
+    place.place = assignment.place;
+    r.finished_places.emplace_back(std::move(place), assignment);
+  };
+  auto stampEstimate = [&](FrameResult& r) {
+    r.estimate = topology_.estimate();
+    map_revision_.store(r.estimate.map_revision);
+    if (r.estimate.map_revision != published_revision) {
+      r.topology = std::make_shared<const TopologySnapshot>(topology_.topology());
+      published_revision = r.estimate.map_revision;
+    }
+  };
+
+  bool clean = true;
+  try {
+    for (;;) {
+      FrameResult r;
+      QueueWait wait = segmented_->popFor(r, kPollPeriod);
+      beat(kTopology);
+      if (wait == QueueWait::Closed) break;
+      if (wait == QueueWait::Item) {
+        const double t0 = clock_.now();
+        if (r.closed_place) {
+          topology_.enqueuePlace(*r.closed_place);
+          pending.push_back(std::move(*r.closed_place));
+          r.closed_place.reset();
+          places_.fetch_add(1);
+        }
+        // The filter's step is spread over frames: at most budget_s of it per frame.
+        const double deadline = t0 + budget_s;
+        while (!topology_.idle()) {
+          const double remaining = deadline - clock_.now();
+          if (remaining <= 0.0) break;
+          if (std::optional<PlaceAssignment> done = topology_.advance(remaining)) attach(r, *done);
+        }
+        stampEstimate(r);
+        r.filter_ms = (clock_.now() - t0) * 1e3;
+        if (!forward(*results_, std::move(r))) break;
+        processed_[kTopology].fetch_add(1);
+      }
+      if (config_.map_save_period_s > 0 && clock_.now() >= next_save_s && topology_.idle()) {
+        try {
+          saveMap();
+        } catch (const std::exception& e) {
+          spdlog::warn("pipeline: periodic map save to {} failed: {}", config_.map_path, e.what());
+        }
+        next_save_s = clock_.now() + config_.map_save_period_s;
+      }
+    }
+    // End of stream or stop: finish the steps in progress, publish them on a flush record, save.
+    FrameResult flush;
+    flush.has_frame = false;
+    while (!topology_.idle())
+      if (std::optional<PlaceAssignment> done = topology_.advance(1e9)) attach(flush, *done);
+    stampEstimate(flush);
+    if (!flush.finished_places.empty() || flush.topology) results_->pushWait(std::move(flush));
+  } catch (const std::exception& e) {
+    clean = false;
+    recordError(std::string("topology: ") + e.what());
+  }
+  if (clean) {
+    try {
+      saveMap();
+    } catch (const std::exception& e) {
+      recordError("saving the map to " + config_.map_path + " failed: " + e.what());
+    }
+  }
+  segmented_->close();
+  results_->close();
+  thread_done_[kTopology].store(true);
+  finished_threads_.fetch_add(1);
+}
+
+void Pipeline::publisherLoop() {
+  const std::size_t expected = 1024;
+  std::vector<double> window[kThreadCount + 1];  // per-stage work and end-to-end latency, this period
+  for (auto& w : window) w.reserve(expected);
+  double period_start = clock_.now();
+  double period_cpu_start = processCpuSeconds();
+  double stage_cpu_start[kThreadCount] = {};
+  std::int64_t published = 0, published_at_period_start = 0;
+
+  auto emitStatus = [&](const char* state) {
+    const double now = clock_.now();
+    const double elapsed = std::max(1e-9, now - period_start);
+    PipelineStatus s;
+    s.time_s = now;
+    s.uptime_s = now - start_time_s_;
+    s.fps = static_cast<double>(published - published_at_period_start) / elapsed;
+    s.frames_captured = processed_[kCapture].load();
+    s.frames_published = published;
+    s.source_skipped = source_skipped_.load();
+    s.latency = summarizeLatencies(window[kThreadCount]);
+    const QueueCounters inputs[kThreadCount] = {QueueCounters{}, frames_->counters(), fingerprints_->counters(),
+                                                segmented_->counters(), results_->counters()};
+    s.stages.reserve(kThreadCount);
+    for (int i = 0; i < kThreadCount; ++i) {
+      StageStatus st;
+      st.name = kStageNames[i];
+      st.latency = summarizeLatencies(window[i]);
+      st.processed = i == kPublisher ? published : processed_[i].load();
+      st.dropped = inputs[i].dropped;
+      st.queue_depth = inputs[i].depth;
+      st.queue_capacity = inputs[i].capacity;
+      const double cpu = thread_cpu_s_[i].load();
+      st.cpu_percent = 100.0 * (cpu - stage_cpu_start[i]) / elapsed;
+      stage_cpu_start[i] = cpu;
+      s.frames_dropped += inputs[i].dropped;
+      s.stages.push_back(std::move(st));
+    }
+    const double process_cpu = processCpuSeconds();
+    s.cpu_percent = 100.0 * (process_cpu - period_cpu_start) / elapsed;
+    s.places = places_.load();
+    s.map_revision = map_revision_.load();
+    s.maps_saved = maps_saved_.load();
+    s.state = state;
+    sink_.publishStatus(s);
+    {
+      std::lock_guard lock(status_mutex_);
+      status_ = std::move(s);
+    }
+    for (auto& w : window) w.clear();
+    period_start = now;
+    period_cpu_start = process_cpu;
+    published_at_period_start = published;
+  };
+
+  try {
+    for (;;) {
+      FrameResult r;
+      QueueWait wait = results_->popFor(r, kPollPeriod);
+      beat(kPublisher);
+      if (wait == QueueWait::Item) {
+        const double t0 = clock_.now();
+        sink_.publish(r);
+        const double t1 = clock_.now();
+        if (r.has_frame) {
+          ++published;
+          const double latency_ms = (t1 - r.captured_at_s) * 1e3;
+          window[kFingerprint].push_back(r.fingerprint_ms);
+          window[kSegmentation].push_back(r.segmentation_ms);
+          window[kTopology].push_back(r.filter_ms);
+          window[kPublisher].push_back((t1 - t0) * 1e3);
+          window[kThreadCount].push_back(latency_ms);
+          if (config_.record_latencies) latencies_ms_.push_back(latency_ms);
+        }
+      }
+      if (wait == QueueWait::Closed) break;
+      if (clock_.now() - period_start >= config_.status_period_s)
+        emitStatus(stop_requested_.load() ? "stopping" : "running");
+    }
+    thread_done_[kPublisher].store(true);
+    emitStatus("finished");
+  } catch (const std::exception& e) {
+    recordError(std::string("publisher: ") + e.what());
+  }
+  results_->close();
+  thread_done_[kPublisher].store(true);
+  finished_threads_.fetch_add(1);
+}
+
+}  // namespace toposlam

@@ -1,0 +1,354 @@
+// FiedlerSegmenter: cached ring-window affinity, L_sym, lambda2, Algorithm 4.1 and representative
+// selection. See the header for the definitions and the reading of the thesis behind them.
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace toposlam {
+
+namespace {
+
+// A similarity must be a finite non-negative number for the Laplacian to be positive semi-definite.
+// Anything else (a bug or a broken measure) is treated as "no link".
+double sanitizeSimilarity(double value) {
+  if (!std::isfinite(value) || value < 0.0) return 0.0;
+  return value;
+}
+
+// Fills `laplacian` (top-left k x k) with L_sym of `affinity` (top-left k x k), using the degree-0
+// convention of the header: isolated nodes get a zero row/column and a zero diagonal.
+void buildSymmetricLaplacian(const Eigen::Ref<const Eigen::MatrixXd>& affinity,
+                             Eigen::Ref<Eigen::VectorXd> degree, Eigen::Ref<Eigen::VectorXd> inv_sqrt_degree,
+                             Eigen::Ref<Eigen::MatrixXd> laplacian) {
+  const Eigen::Index k = affinity.rows();
+  degree = affinity.rowwise().sum();
+  for (Eigen::Index i = 0; i < k; ++i) {
+    inv_sqrt_degree(i) = degree(i) > 0.0 ? 1.0 / std::sqrt(degree(i)) : 0.0;
+  }
+  for (Eigen::Index j = 0; j < k; ++j) {
+    for (Eigen::Index i = 0; i < k; ++i) {
+      laplacian(i, j) = -inv_sqrt_degree(i) * affinity(i, j) * inv_sqrt_degree(j);
+    }
+    // The affinity's diagonal is zero, so L_sym(j, j) = 1 (Chung: 0 for an isolated node).
+    laplacian(j, j) = degree(j) > 0.0 ? 1.0 : 0.0;
+  }
+}
+
+}  // namespace
+
+const char* toString(CutPlacement placement) {
+  switch (placement) {
+    case CutPlacement::WindowSplit:
+      return "window-split";
+    case CutPlacement::ValleyFrame:
+      return "valley-frame";
+  }
+  return "?";
+}
+
+CutPlacement parseCutPlacement(const std::string& name) {
+  if (name == "window-split") return CutPlacement::WindowSplit;
+  if (name == "valley-frame") return CutPlacement::ValleyFrame;
+  throw std::invalid_argument("cut placement '" + name + "' is unknown: use window-split or valley-frame");
+}
+
+double maxFiedlerValue(int nodes) {
+  if (nodes < 2) return 0.0;
+  return static_cast<double>(nodes) / static_cast<double>(nodes - 1);
+}
+
+std::string FiedlerSegmenterConfig::validate() const {
+  if (window < 3 || window > 1000) {
+    return "window: " + std::to_string(window) + " frames is outside the allowed range [3, 1000]";
+  }
+  if (std::string problem = valley.validate(maxFiedlerValue(window)); !problem.empty()) return problem;
+  if (min_keypoints < 0 || min_keypoints > 100000) {
+    return "min_keypoints: " + std::to_string(min_keypoints) + " is outside the allowed range [0, 100000]";
+  }
+  if (cut_placement != CutPlacement::WindowSplit && cut_placement != CutPlacement::ValleyFrame) {
+    return "cut_placement: unknown value (allowed: window-split, valley-frame)";
+  }
+  return "";
+}
+
+double fiedlerValue(const Eigen::MatrixXd& affinity) {
+  if (affinity.rows() != affinity.cols()) {
+    throw std::invalid_argument("fiedlerValue: the affinity matrix must be square, got " +
+                                std::to_string(affinity.rows()) + "x" + std::to_string(affinity.cols()));
+  }
+  const Eigen::Index k = affinity.rows();
+  if (k < 2) return 0.0;
+  Eigen::MatrixXd links = affinity.unaryExpr([](double v) { return sanitizeSimilarity(v); });
+  links.diagonal().setZero();
+  Eigen::VectorXd degree(k), inv_sqrt_degree(k);
+  Eigen::MatrixXd laplacian(k, k);
+  buildSymmetricLaplacian(links, degree, inv_sqrt_degree, laplacian);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(laplacian, Eigen::EigenvaluesOnly);
+  return std::max(0.0, solver.eigenvalues()(1));
+}
+
+FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity)
+    : config_(config),
+      similarity_(similarity),
+      detector_([&config] {
+        if (const std::string problem = config.validate(); !problem.empty()) {
+          throw std::invalid_argument("segmentation config: " + problem);
+        }
+        return config.valley;
+      }()),
+      // Sized once here (after detector_ validated the config): compute() on an n x n matrix then
+      // reuses this storage. (Assigning a solver would copy its uninitialised status field.)
+      solver_(config.window) {
+  const int n = config_.window;
+  slot_fingerprint_.resize(static_cast<std::size_t>(n));
+  slot_frame_.assign(static_cast<std::size_t>(n), -1);
+  slot_time_.assign(static_cast<std::size_t>(n), 0.0);
+  affinity_ = Eigen::MatrixXd::Zero(n, n);
+  degree_ = Eigen::VectorXd::Zero(n);
+  inv_sqrt_degree_ = Eigen::VectorXd::Zero(n);
+  laplacian_ = Eigen::MatrixXd::Zero(n, n);
+  candidates_.reserve(static_cast<std::size_t>(4 * n));
+}
+
+int FiedlerSegmenter::slotAtPosition(int position) const {
+  const int oldest = count_ == config_.window ? next_slot_ : 0;
+  return (oldest + position) % config_.window;
+}
+
+double FiedlerSegmenter::computeLambda2() {
+  const int k = count_;
+  if (k == config_.window) {
+    // Steady state: the full preallocated matrices, no allocation.
+    buildSymmetricLaplacian(affinity_, degree_, inv_sqrt_degree_, laplacian_);
+    solver_.compute(laplacian_, Eigen::EigenvaluesOnly);
+  } else {
+    // Filling up: slots 0..k-1 are the occupied ones.
+    buildSymmetricLaplacian(affinity_.topLeftCorner(k, k), degree_.head(k), inv_sqrt_degree_.head(k),
+                            laplacian_.topLeftCorner(k, k));
+    solver_.compute(laplacian_.topLeftCorner(k, k), Eigen::EigenvaluesOnly);
+  }
+  // L_sym is positive semi-definite; clamp round-off below zero.
+  return std::max(0.0, solver_.eigenvalues()(1));
+}
+
+void FiedlerSegmenter::addCandidate(const Candidate& candidate) {
+  for (Candidate& existing : candidates_) {
+    if (existing.frame == candidate.frame) {
+      if (candidate.degree > existing.degree) existing.degree = candidate.degree;
+      return;
+    }
+  }
+  candidates_.push_back(candidate);
+  if (candidates_.size() > static_cast<std::size_t>(2 * config_.window)) compactCandidates();
+}
+
+void FiedlerSegmenter::compactCandidates() {
+  // Every future border is at or after `bound`: a future valley's split lies after the oldest frame of
+  // the current window, and a pending one is known. Candidates before it all belong to the open place,
+  // so only their best can ever be chosen.
+  std::int64_t bound = slot_frame_[static_cast<std::size_t>(slotAtPosition(0))];
+  if (!detector_.lookingForPeak() && pending_min_frame_ >= 0 && pending_min_frame_ == detector_.minIndex()) {
+    bound = std::min(bound, pending_border_frame_ >= 0 ? pending_border_frame_ : pending_min_frame_ + 1);
+  }
+  const Candidate* best = nullptr;
+  for (const Candidate& c : candidates_) {
+    if (c.frame < bound &&
+        (best == nullptr || c.degree > best->degree || (c.degree == best->degree && c.frame < best->frame))) {
+      best = &c;
+    }
+  }
+  if (best == nullptr) return;
+  const std::int64_t keep = best->frame;
+  std::erase_if(candidates_, [&](const Candidate& c) { return c.frame < bound && c.frame != keep; });
+}
+
+void FiedlerSegmenter::rememberBestWindowFrame(std::int64_t from_frame, std::int64_t before_frame) {
+  int best_slot = -1;
+  for (int position = 0; position < count_; ++position) {
+    const int slot = slotAtPosition(position);
+    const std::int64_t frame = slot_frame_[static_cast<std::size_t>(slot)];
+    if (frame < from_frame || frame >= before_frame) continue;
+    // Strictly larger: on ties the oldest frame wins (positions run oldest first).
+    if (best_slot < 0 || degree_(slot) > degree_(best_slot)) best_slot = slot;
+  }
+  if (best_slot < 0) return;
+  const auto s = static_cast<std::size_t>(best_slot);
+  addCandidate(Candidate{slot_frame_[s], degree_(best_slot), slot_time_[s], slot_fingerprint_[s]});
+}
+
+int FiedlerSegmenter::bestSplitPosition() const {
+  // Sweep the temporal splits [0, t) | [t, k) of the window and take the smallest normalised cut.
+  // cut(t+1) = cut(t) - sum_{i<t} a(i,t) + sum_{j>t} a(t,j); vol = prefix sums of the degrees.
+  const int k = count_;
+  double total_volume = 0.0;
+  for (int p = 0; p < k; ++p) total_volume += degree_(slotAtPosition(p));
+  double cut = 0.0;
+  double volume_before = 0.0;
+  double best_value = std::numeric_limits<double>::infinity();
+  int best_position = -1;
+  for (int t = 1; t < k; ++t) {
+    const int moved = slotAtPosition(t - 1);  // the frame that moves from the newer to the older part
+    for (int p = 0; p < k; ++p) {
+      if (p == t - 1) continue;
+      const double a = affinity_(moved, slotAtPosition(p));
+      cut += p < t - 1 ? -a : a;
+    }
+    volume_before += degree_(moved);
+    const std::int64_t first_newer = slot_frame_[static_cast<std::size_t>(slotAtPosition(t))];
+    if (first_newer <= place_start_) continue;  // the border must fall inside the open place
+    const double volume_after = total_volume - volume_before;
+    if (volume_before <= 0.0 || volume_after <= 0.0) continue;
+    const double value = std::max(0.0, cut) * (1.0 / volume_before + 1.0 / volume_after);
+    if (value < best_value) {
+      best_value = value;
+      best_position = t;
+    }
+  }
+  return best_position;
+}
+
+SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s,
+                                         std::shared_ptr<const Fingerprint> fingerprint) {
+  if (!fingerprint) throw std::invalid_argument("FiedlerSegmenter::addFrame: null fingerprint");
+  if (frame_index <= last_frame_) {
+    throw std::invalid_argument("FiedlerSegmenter::addFrame: frame " + std::to_string(frame_index) +
+                                " does not follow frame " + std::to_string(last_frame_) +
+                                " (frame indices must increase)");
+  }
+  // ValleyFrame: the border after a recorded minimum is the frame that follows it.
+  if (pending_min_frame_ >= 0 && pending_min_frame_ == last_frame_ && pending_border_frame_ < 0 &&
+      config_.cut_placement == CutPlacement::ValleyFrame) {
+    pending_border_frame_ = frame_index;
+    pending_border_time_s_ = time_s;
+  }
+
+  const int n = config_.window;
+  const int slot = next_slot_;
+  const auto s = static_cast<std::size_t>(slot);
+  slot_fingerprint_[s] = std::move(fingerprint);
+  slot_frame_[s] = frame_index;
+  slot_time_[s] = time_s;
+  const int occupied_before = count_;
+  // Only the new frame's row and column are new: 2 (k-1) similarity calls.
+  affinity_(slot, slot) = 0.0;
+  for (int other = 0; other < n; ++other) {
+    if (other == slot) continue;
+    double value = 0.0;
+    if (occupied_before == n || other < occupied_before) {
+      value = sanitizeSimilarity(similarity_.symmetricSimilarity(
+          *slot_fingerprint_[static_cast<std::size_t>(other)], *slot_fingerprint_[s]));
+    }
+    affinity_(slot, other) = value;
+    affinity_(other, slot) = value;
+  }
+  count_ = std::min(count_ + 1, n);
+  next_slot_ = (slot + 1) % n;
+  last_frame_ = frame_index;
+  last_time_s_ = time_s;
+  if (place_start_ < 0) {
+    place_start_ = frame_index;
+    place_start_time_s_ = time_s;
+  }
+
+  SegmenterStep step;
+  step.frame = frame_index;
+  if (count_ >= 2) {
+    step.lambda2 = computeLambda2();
+  } else {
+    degree_.setZero();
+  }
+  rememberBestWindowFrame(place_start_, std::numeric_limits<std::int64_t>::max());
+
+  // The detector sees lambda2 only once the window is full: while it fills, lambda2 of a perfectly
+  // connected window falls as k/(k-1) (2, 1.5, 1.33, ...), which would read as a peak.
+  if (count_ == n && step.lambda2) {
+    const std::optional<std::int64_t> valley = detector_.update(frame_index, *step.lambda2);
+    if (!detector_.lookingForPeak() && detector_.minIndex() == frame_index) {
+      // A new minimum: remember where its border would be and a candidate before that border.
+      pending_min_frame_ = frame_index;
+      pending_border_frame_ = -1;
+      if (config_.cut_placement == CutPlacement::WindowSplit) {
+        const int position = bestSplitPosition();
+        if (position > 0) {
+          const int border_slot = slotAtPosition(position);
+          const int last_slot = slotAtPosition(position - 1);
+          pending_border_frame_ = slot_frame_[static_cast<std::size_t>(border_slot)];
+          pending_border_time_s_ = slot_time_[static_cast<std::size_t>(border_slot)];
+          pending_last_frame_ = slot_frame_[static_cast<std::size_t>(last_slot)];
+          pending_last_time_s_ = slot_time_[static_cast<std::size_t>(last_slot)];
+          rememberBestWindowFrame(place_start_, pending_border_frame_);
+        }
+      } else {
+        pending_last_frame_ = frame_index;
+        pending_last_time_s_ = time_s;
+        rememberBestWindowFrame(place_start_, frame_index + 1);
+      }
+    }
+    if (valley) {
+      if (pending_min_frame_ == *valley && pending_border_frame_ > place_start_) {
+        step.closed_place = closePlace(*valley, pending_border_frame_, pending_border_time_s_);
+      } else {
+        ++ignored_valleys_;
+      }
+      pending_min_frame_ = -1;
+      pending_border_frame_ = -1;
+    }
+  }
+  return step;
+}
+
+SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
+                                            double next_start_time_s) {
+  SegmentedPlace place;
+  place.first_frame = place_start_;
+  place.first_time_s = place_start_time_s_;
+  place.last_frame = valley_frame < 0 ? last_frame_ : pending_last_frame_;
+  place.last_time_s = valley_frame < 0 ? last_time_s_ : pending_last_time_s_;
+  place.valley_frame = valley_frame;
+  const std::int64_t last_frame = place.last_frame;
+
+  const Candidate* best = nullptr;
+  for (const Candidate& c : candidates_) {
+    if (c.frame < place_start_ || c.frame > last_frame) continue;
+    if (best == nullptr || c.degree > best->degree || (c.degree == best->degree && c.frame < best->frame)) {
+      best = &c;
+    }
+  }
+  if (best != nullptr) {
+    place.representative_frame = best->frame;
+    place.representative_degree = best->degree;
+    place.representative = best->fingerprint;
+    place.representative_keypoints = best->fingerprint ? best->fingerprint->keypointCount() : 0;
+  }
+  place.dropped = place.representative_keypoints < config_.min_keypoints;
+  place.index = place.dropped ? dropped_places_++ : kept_places_++;
+
+  std::erase_if(candidates_, [&](const Candidate& c) { return c.frame <= last_frame; });
+  place_start_ = next_start_frame;
+  place_start_time_s_ = next_start_time_s;
+  return place;
+}
+
+std::optional<SegmentedPlace> FiedlerSegmenter::flush() {
+  if (place_start_ < 0 || place_start_ > last_frame_) return std::nullopt;
+  rememberBestWindowFrame(place_start_, last_frame_ + 1);
+  SegmentedPlace place = closePlace(-1, -1, 0.0);
+  place_start_ = -1;  // the next frame added opens a new place
+  pending_min_frame_ = -1;
+  pending_border_frame_ = -1;
+  return place;
+}
+
+Eigen::MatrixXd FiedlerSegmenter::affinityInWindowOrder() const {
+  Eigen::MatrixXd ordered(count_, count_);
+  for (int i = 0; i < count_; ++i) {
+    for (int j = 0; j < count_; ++j) ordered(i, j) = affinity_(slotAtPosition(i), slotAtPosition(j));
+  }
+  return ordered;
+}
+
+}  // namespace toposlam

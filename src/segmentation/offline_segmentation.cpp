@@ -1,0 +1,127 @@
+// OfflineSegmentation: fingerprint -> segment for file-based runs, and the run-folder writers.
+#include "toposlam/segmentation/offline_segmentation.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace toposlam {
+
+namespace {
+
+std::string formatNumber(double value, int decimals) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+std::int64_t nodeOf(const std::vector<std::int64_t>& place_nodes, std::int64_t place) {
+  if (place < 0 || place >= static_cast<std::int64_t>(place_nodes.size())) return -1;
+  return place_nodes[static_cast<std::size_t>(place)];
+}
+
+}  // namespace
+
+OfflineSegmentation::OfflineSegmentation(const VpackExtractor& extractor, const SimilarityMeasure& similarity,
+                                         const FiedlerSegmenterConfig& config)
+    : extractor_(extractor), segmenter_(config, similarity) {}
+
+std::shared_ptr<const Fingerprint> OfflineSegmentation::fingerprint(const cv::Mat& image) const {
+  return std::make_shared<const Fingerprint>(extractor_.extract(image));
+}
+
+SegmenterStep OfflineSegmentation::segment(double time_s, const std::string& name,
+                                           std::shared_ptr<const Fingerprint> fingerprint) {
+  SegmentationFrameRecord row;
+  row.frame = static_cast<std::int64_t>(run_.frames.size());
+  row.time_s = time_s;
+  row.name = name;
+  row.keypoints = fingerprint ? fingerprint->keypointCount() : 0;
+  SegmenterStep step = segmenter_.addFrame(row.frame, time_s, std::move(fingerprint));
+  row.lambda2 = step.lambda2;
+  run_.frames.push_back(std::move(row));
+  if (step.closed_place) record(*step.closed_place);
+  return step;
+}
+
+SegmenterStep OfflineSegmentation::process(const cv::Mat& image, double time_s, const std::string& name) {
+  return segment(time_s, name, fingerprint(image));
+}
+
+std::optional<SegmentedPlace> OfflineSegmentation::finish() {
+  std::optional<SegmentedPlace> last = segmenter_.flush();
+  if (last) record(*last);
+  return last;
+}
+
+void OfflineSegmentation::record(const SegmentedPlace& place) {
+  const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, place.first_frame));
+  const auto end = std::min(run_.frames.size(), static_cast<std::size_t>(place.last_frame + 1));
+  for (std::size_t f = first; f < end; ++f) {
+    run_.frames[f].place = place.dropped ? -1 : place.index;
+    run_.frames[f].in_dropped_place = place.dropped;
+  }
+  (place.dropped ? run_.dropped_places : run_.places).push_back(place);
+}
+
+void writeFramesCsv(std::ostream& out, const SegmentationRun& run,
+                    const std::vector<std::int64_t>& place_nodes) {
+  out << "frame,time,name,lambda2,place,node\n";
+  for (const SegmentationFrameRecord& row : run.frames) {
+    out << row.frame << ',' << formatNumber(row.time_s, 6) << ',' << row.name << ','
+        << (row.lambda2 ? formatNumber(*row.lambda2, 6) : std::string()) << ',' << row.place << ','
+        << nodeOf(place_nodes, row.place) << '\n';
+  }
+}
+
+void writePlacesCsv(std::ostream& out, const std::vector<SegmentedPlace>& places,
+                    const std::vector<std::int64_t>& place_nodes) {
+  out << "place,first,last,representative,keypoints,node\n";
+  for (const SegmentedPlace& p : places) {
+    out << p.index << ',' << p.first_frame << ',' << p.last_frame << ',' << p.representative_frame << ','
+        << p.representative_keypoints << ',' << (p.dropped ? -1 : nodeOf(place_nodes, p.index)) << '\n';
+  }
+}
+
+SvgPlot lambda2Plot(const SegmentationRun& run, const FiedlerSegmenterConfig& config,
+                    const std::string& title) {
+  SvgPlot plot;
+  plot.title = title;
+  plot.x_label = "frame";
+  plot.y_label = "algebraic connectivity (lambda2)";
+  SvgSeries series;
+  series.label = "lambda2, window " + std::to_string(config.window);
+  for (const SegmentationFrameRecord& row : run.frames) {
+    series.x.push_back(static_cast<double>(row.frame));
+    series.y.push_back(row.lambda2 ? *row.lambda2 : std::nan(""));
+  }
+  plot.series.push_back(std::move(series));
+  // A border is drawn between the last frame of a place and the first of the next.
+  for (const SegmentedPlace& p : run.places) {
+    if (p.valley_frame < 0) continue;  // closed by the end of the stream
+    SvgLine line;
+    line.value = static_cast<double>(p.last_frame) + 0.5;
+    line.colour = "#d62728";
+    plot.vertical_lines.push_back(line);
+  }
+  for (const SegmentedPlace& p : run.dropped_places) {
+    if (p.valley_frame < 0) continue;
+    SvgLine line;
+    line.value = static_cast<double>(p.last_frame) + 0.5;
+    line.colour = "#aaaaaa";
+    plot.vertical_lines.push_back(line);
+  }
+  SvgLine gamma;
+  gamma.value = config.valley.gamma;
+  gamma.colour = "#2ca02c";
+  gamma.label = "gamma " + formatNumber(config.valley.gamma, 2);
+  plot.horizontal_lines.push_back(gamma);
+  plot.y_min = 0.0;
+  plot.y_max = std::max(maxFiedlerValue(config.window), 0.1) * 1.05;
+  if (!run.frames.empty()) {
+    plot.x_min = 0.0;
+    plot.x_max = std::max(1.0, static_cast<double>(run.frames.size() - 1));
+  }
+  return plot;
+}
+
+}  // namespace toposlam

@@ -1,0 +1,652 @@
+// TopologyParticleFilter: the step machine (collect, similarity, aggregate, propose, resample, update),
+// the estimate, and state (de)serialisation. See the header and docs/topology.md.
+#include "toposlam/topology/topology_particle_filter.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "binary_io.hpp"
+#include "topology_state.hpp"
+
+namespace toposlam {
+
+using topology_detail::BinaryReader;
+using topology_detail::BinaryWriter;
+using topology_detail::HistoryRecord;
+using topology_detail::kTrieBits;
+using topology_detail::kTrieFanout;
+using topology_detail::NodeEntry;
+using topology_detail::TopologyState;
+using topology_detail::TrieBranch;
+using topology_detail::TrieLeaf;
+using topology_detail::TrieNode;
+
+namespace {
+
+std::size_t idx(std::int64_t i) { return static_cast<std::size_t>(i); }
+
+/// eta from S1 = sum L, S2 = sum L log L over n known nodes: sum p log p = S2 / S1 - log S1.
+double entropyFromSums(double sum, double sum_l_log_l, int n) {
+  if (n <= 1 || !(sum > 0.0)) return 1.0;
+  const double eta = -(sum_l_log_l / sum - std::log(sum)) / std::log(static_cast<double>(n));
+  return std::clamp(eta, 0.0, 1.0);
+}
+
+double lLogL(double l) { return l > 0.0 ? l * std::log(l) : 0.0; }
+
+double entryLikelihood(const NodeEntry& entry, const std::vector<double>& similarity) {
+  double best = 0.0;
+  for (int r = 0; r < entry.representative_count; ++r) {
+    best = std::max(best, similarity[idx(entry.representatives[idx(r)])]);
+  }
+  return best;
+}
+
+/// Marks the observations referenced below `node` (each shared trie node once per stamp).
+void markReferenced(const TrieNode* node, int level, std::uint64_t stamp,
+                    std::vector<unsigned char>& needed) {
+  if (!node || node->visit_stamp == stamp) return;
+  node->visit_stamp = stamp;
+  if (level == 0) {
+    for (const NodeEntry& entry : static_cast<const TrieLeaf*>(node)->entries) {
+      for (int r = 0; r < entry.representative_count; ++r) needed[idx(entry.representatives[idx(r)])] = 1;
+    }
+    return;
+  }
+  for (const auto& child : static_cast<const TrieBranch*>(node)->children) {
+    markReferenced(child.get(), level - 1, stamp, needed);
+  }
+}
+
+/// Sums of node likelihoods below `node`, memoised per stamp (shared subtrees are summed once).
+void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::vector<double>& similarity) {
+  if (node->memo_stamp == stamp) return;
+  double sum = 0.0, sum_l_log_l = 0.0, max = 0.0;
+  if (level == 0) {
+    for (const NodeEntry& entry : static_cast<const TrieLeaf*>(node)->entries) {
+      if (entry.first_observation < 0) continue;
+      const double l = entryLikelihood(entry, similarity);
+      sum += l;
+      sum_l_log_l += lLogL(l);
+      max = std::max(max, l);
+    }
+  } else {
+    for (const auto& child : static_cast<const TrieBranch*>(node)->children) {
+      if (!child) continue;
+      aggregate(child.get(), level - 1, stamp, similarity);
+      sum += child->memo_sum;
+      sum_l_log_l += child->memo_sum_l_log_l;
+      max = std::max(max, child->memo_max);
+    }
+  }
+  node->memo_sum = sum;
+  node->memo_sum_l_log_l = sum_l_log_l;
+  node->memo_max = max;
+  node->memo_stamp = stamp;
+}
+
+std::vector<int> assignmentOf(const TopologyState& state) {
+  std::vector<int> out;
+  for (const HistoryRecord* r = state.record.get(); r; r = r->parent.get()) out.push_back(r->node);
+  std::reverse(out.begin(), out.end());
+  return out;
+}
+
+void countTrieNodes(const TrieNode* node, int level, std::unordered_set<const TrieNode*>& seen) {
+  if (!node || !seen.insert(node).second || level == 0) return;
+  for (const auto& child : static_cast<const TrieBranch*>(node)->children)
+    countTrieNodes(child.get(), level - 1, seen);
+}
+
+}  // namespace
+
+std::string TopologyFilterConfig::validate() const {
+  if (particles < 1 || particles > 1000000) return "particles: must be in [1, 1000000]";
+  if (!(alpha > 0.0 && alpha <= 1e6)) return "alpha: must be in (0, 1e6]";
+  if (!(new_node_probability > 0.0 && new_node_probability < 1.0))
+    return "new_node_probability: must be in (0, 1)";
+  if (!(gamma_shape > 0.0 && gamma_shape <= 1000.0)) return "gamma_shape: must be in (0, 1000]";
+  if (!(gamma_scale > 0.0 && gamma_scale <= 100.0)) return "gamma_scale: must be in (0, 100]";
+  if (max_successors < 1 || max_successors > kTopologyMaxSuccessors)
+    return "max_successors: must be in [1, 8]";
+  if (max_representatives_per_node < 1 || max_representatives_per_node > kTopologyMaxRepresentatives) {
+    return "max_representatives_per_node: must be in [1, 16]";
+  }
+  return "";
+}
+
+double gammaPdf(double x, double shape, double scale) {
+  if (!(x > 0.0)) return 0.0;
+  return std::exp((shape - 1.0) * std::log(x) - x / scale - std::lgamma(shape) - shape * std::log(scale));
+}
+
+double normalisedEntropy(std::span<const double> likelihoods) {
+  double sum = 0.0, sum_l_log_l = 0.0;
+  for (double l : likelihoods) {
+    sum += l;
+    sum_l_log_l += lLogL(l);
+  }
+  return entropyFromSums(sum, sum_l_log_l, static_cast<int>(likelihoods.size()));
+}
+
+double newNodeLikelihood(std::span<const double> known_likelihoods) {
+  if (known_likelihoods.empty()) return 1.0;
+  const double max = *std::max_element(known_likelihoods.begin(), known_likelihoods.end());
+  return normalisedEntropy(known_likelihoods) * (1.0 - max);
+}
+
+KnownNodeTransition knownNodeTransition(const TopologyFilterConfig& config) {
+  KnownNodeTransition t;
+  std::array<double, kTopologyMaxSuccessors + 1> raw{};
+  double total = 0.0;
+  for (int j = 0; j <= config.max_successors; ++j) {
+    raw[idx(j)] = gammaPdf(j + 1.0, config.gamma_shape, config.gamma_scale);
+    total += raw[idx(j)];
+  }
+  const double scale = (1.0 - config.new_node_probability) / total;
+  t.stay = raw[0] * scale;
+  for (int j = 1; j <= config.max_successors; ++j) t.successor.push_back(raw[idx(j)] * scale);
+  t.new_node = config.new_node_probability;
+  return t;
+}
+
+TopologyParticleFilter::TopologyParticleFilter(const TopologyFilterConfig& config,
+                                               const SimilarityMeasure& similarity)
+    : config_(config), similarity_(similarity) {
+  if (const std::string problem = config_.validate(); !problem.empty()) throw std::invalid_argument(problem);
+  rng_.seed(config_.seed);
+  transition_ = knownNodeTransition(config_);
+  particles_.assign(idx(config_.particles), std::make_shared<const TopologyState>());
+}
+
+TopologyParticleFilter::~TopologyParticleFilter() = default;
+
+double TopologyParticleFilter::uniform01() {
+  // 53 random bits -> [0, 1), identical on every platform (std distributions are not specified).
+  return static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+}
+
+void TopologyParticleFilter::beginStep(std::shared_ptr<const Fingerprint> representative) {
+  if (phase_ != Phase::Idle) throw std::logic_error("TopologyParticleFilter: a step is already in progress");
+  if (!representative) throw std::invalid_argument("TopologyParticleFilter: null representative");
+  if (observation_count_ == std::numeric_limits<std::int32_t>::max())
+    throw std::length_error("too many observations");
+  pending_ = std::move(representative);
+  ++stamp_;
+  const std::size_t m = particles_.size();
+  groups_.clear();
+  group_of_.assign(m, 0);
+  std::unordered_map<const TopologyState*, std::int32_t> group_index;
+  for (std::size_t i = 0; i < m; ++i) {
+    auto [it, inserted] = group_index.emplace(particles_[i].get(), static_cast<std::int32_t>(groups_.size()));
+    if (inserted) groups_.push_back(particles_[i]);
+    group_of_[i] = it->second;
+  }
+  needed_.assign(idx(observation_count_), 0);
+  needed_list_.clear();
+  similarity_of_.assign(idx(observation_count_), 0.0);
+  group_stats_.assign(groups_.size(), GroupStats{});
+  proposal_.assign(m, 0);
+  weight_.assign(m, 0.0);
+  chosen_.assign(m, 0);
+  next_particles_.assign(m, nullptr);
+  child_index_.clear();
+  phase_ = Phase::Collect;
+  cursor_ = 0;
+}
+
+bool TopologyParticleFilter::advance(std::size_t budget) {
+  if (budget == 0) throw std::invalid_argument("TopologyParticleFilter::advance: budget must be >= 1");
+  std::size_t used = 0;
+  const std::size_t m = particles_.size();
+  while (phase_ != Phase::Idle) {
+    switch (phase_) {
+      case Phase::Collect:
+        for (; cursor_ < groups_.size(); ++cursor_) {
+          if (used++ >= budget) return false;
+          const TopologyState& g = *groups_[cursor_];
+          markReferenced(g.nodes.root().get(), g.nodes.levels(), stamp_, needed_);
+        }
+        for (std::size_t o = 0; o < needed_.size(); ++o) {
+          if (needed_[o]) {
+            needed_list_.push_back(static_cast<std::int32_t>(o));
+          } else {
+            fingerprints_[o].reset();  // no particle refers to it any more: forget it
+          }
+        }
+        phase_ = Phase::Similarity;
+        cursor_ = 0;
+        break;
+      case Phase::Similarity:
+        for (; cursor_ < needed_list_.size(); ++cursor_) {
+          if (used++ >= budget) return false;
+          const auto o = idx(needed_list_[cursor_]);
+          const double s = similarity_.similarity(*fingerprints_[o], *pending_);
+          similarity_of_[o] = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
+        }
+        phase_ = Phase::Aggregate;
+        cursor_ = 0;
+        break;
+      case Phase::Aggregate:
+        for (; cursor_ < groups_.size(); ++cursor_) {
+          if (used++ >= budget) return false;
+          const TopologyState& g = *groups_[cursor_];
+          GroupStats& stats = group_stats_[cursor_];
+          if (g.nodeCount() == 0) continue;  // first observation: nothing known
+          aggregate(g.nodes.root().get(), g.nodes.levels(), stamp_, similarity_of_);
+          const TrieNode& root = *g.nodes.root();
+          stats.max = root.memo_max;
+          stats.new_likelihood =
+              entropyFromSums(root.memo_sum, root.memo_sum_l_log_l, g.nodeCount()) * (1.0 - stats.max);
+        }
+        phase_ = Phase::Propose;
+        cursor_ = 0;
+        break;
+      case Phase::Propose:
+        for (; cursor_ < m; ++cursor_) {
+          if (used++ >= budget) return false;
+          const auto g = idx(group_of_[cursor_]);
+          const TopologyState& state = *groups_[g];
+          const int n = state.nodeCount();
+          std::int32_t next = n;  // new node unless chosen otherwise
+          if (n > 0) {
+            const int current = state.currentNode();
+            const NodeEntry& entry = state.nodes.get(current);
+            if (entry.successor_count == 0) {
+              // No adjacency information (never left this node): eq. 5.8.
+              const double u = uniform01() * (n + config_.alpha);
+              if (u < n) next = std::min(static_cast<std::int32_t>(u), static_cast<std::int32_t>(n - 1));
+            } else {
+              const double u = uniform01();
+              double cumulative = transition_.stay;
+              if (u < cumulative) {
+                next = current;
+              } else {
+                const int previous = state.previousNode();
+                std::size_t rank = 0;
+                for (int s = 0; s < entry.successor_count && rank < transition_.successor.size(); ++s) {
+                  const std::int32_t candidate = entry.successors[idx(s)];
+                  if (config_.forbid_return_to_previous && candidate == previous) continue;
+                  cumulative += transition_.successor[rank++];
+                  if (u < cumulative) {
+                    next = candidate;
+                    break;
+                  }
+                }
+              }
+            }
+          }
+          proposal_[cursor_] = next;
+          weight_[cursor_] = next == n ? group_stats_[g].new_likelihood
+                                       : entryLikelihood(state.nodes.get(next), similarity_of_);
+        }
+        phase_ = Phase::Resample;
+        cursor_ = 0;
+        break;
+      case Phase::Resample: {
+        if (used++ >= budget) return false;
+        double total = 0.0, total_sq = 0.0;
+        for (double w : weight_) {
+          total += w;
+          total_sq += w * w;
+        }
+        if (!(total > 0.0) || !std::isfinite(total)) {
+          std::fill(weight_.begin(), weight_.end(), 1.0);
+          total = static_cast<double>(m);
+          total_sq = total;
+          ++degenerate_steps_;
+        }
+        last_ess_ = total * total / total_sq;
+        // Systematic resampling: one uniform offset, M evenly spaced pointers.
+        const double spacing = total / static_cast<double>(m);
+        double pointer = uniform01() * spacing;
+        std::size_t i = 0;
+        double cumulative = weight_[0];
+        for (std::size_t j = 0; j < m; ++j) {
+          while (cumulative <= pointer && i + 1 < m) cumulative += weight_[++i];
+          chosen_[j] = static_cast<std::int32_t>(i);
+          pointer += spacing;
+        }
+        phase_ = Phase::Update;
+        cursor_ = 0;
+        break;
+      }
+      case Phase::Update:
+        for (; cursor_ < m; ++cursor_) {
+          if (used++ >= budget) return false;
+          const auto source = idx(chosen_[cursor_]);
+          const auto g = static_cast<std::uint64_t>(group_of_[source]);
+          const auto node = static_cast<std::uint64_t>(proposal_[source]);
+          const std::uint64_t key = (g << 32) | node;
+          auto [it, inserted] = child_index_.emplace(key, static_cast<std::int32_t>(children_.size()));
+          if (inserted) {
+            children_.push_back(topology_detail::extendState(*groups_[idx(g)], observation_count_,
+                                                             proposal_[source], config_));
+          }
+          next_particles_[cursor_] = children_[idx(it->second)];
+        }
+        finishStep();
+        break;
+      case Phase::Idle:
+        break;
+    }
+  }
+  return true;
+}
+
+void TopologyParticleFilter::finishStep() {
+  particles_.swap(next_particles_);
+  next_particles_.clear();
+  children_.clear();
+  child_index_.clear();
+  groups_.clear();
+  fingerprints_.push_back(std::move(pending_));
+  pending_.reset();
+  ++observation_count_;
+  phase_ = Phase::Idle;
+  cursor_ = 0;
+}
+
+void TopologyParticleFilter::step(std::shared_ptr<const Fingerprint> representative) {
+  beginStep(std::move(representative));
+  while (!advance(std::numeric_limits<std::size_t>::max())) {
+  }
+}
+
+std::vector<int> TopologyParticleFilter::particleAssignment(int i) const {
+  return assignmentOf(*particles_.at(idx(i)));
+}
+
+std::shared_ptr<const Fingerprint> TopologyParticleFilter::storedRepresentative(int observation) const {
+  if (observation < 0 || idx(observation) >= fingerprints_.size()) return nullptr;
+  return fingerprints_[idx(observation)];
+}
+
+TopologyEstimate TopologyParticleFilter::estimate(int alternatives) const {
+  if (phase_ != Phase::Idle)
+    throw std::logic_error("TopologyParticleFilter::estimate: a step is in progress");
+  TopologyEstimate out;
+  out.observations = observation_count_;
+  out.effective_sample_size = last_ess_;
+  const double m = static_cast<double>(particles_.size());
+  // Distinct states in order of their first particle, with counts.
+  std::vector<const TopologyState*> states;
+  std::vector<int> counts;
+  std::unordered_map<const TopologyState*, std::size_t> index;
+  for (const auto& p : particles_) {
+    auto [it, inserted] = index.emplace(p.get(), states.size());
+    if (inserted) {
+      states.push_back(p.get());
+      counts.push_back(0);
+    }
+    ++counts[it->second];
+  }
+  out.distinct_topologies = static_cast<int>(states.size());
+  std::vector<std::size_t> order(states.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return counts[a] > counts[b]; });
+
+  auto describe = [&](std::size_t s) {
+    TopologyHypothesis h;
+    h.assignment = assignmentOf(*states[s]);
+    h.probability = counts[s] / m;
+    h.node_count = states[s]->nodeCount();
+    h.current_node = states[s]->currentNode();
+    return h;
+  };
+  out.best = describe(order[0]);
+  for (std::size_t k = 1; k < order.size() && static_cast<int>(k) <= alternatives; ++k) {
+    TopologyHypothesis h = describe(order[k]);
+    for (std::size_t o = 0; o < h.assignment.size(); ++o) {
+      if (h.assignment[o] != out.best.assignment[o]) {
+        h.first_difference = static_cast<int>(o);
+        break;
+      }
+    }
+    out.alternatives.push_back(std::move(h));
+  }
+  out.current_node = out.best.current_node;
+  if (observation_count_ == 0) return out;
+
+  // Current-node hypotheses, identified by the first observation of the node.
+  const TopologyState& best = *states[order[0]];
+  std::unordered_map<int, int> best_node_of_founder;
+  for (int n = 0; n < best.nodeCount(); ++n) best_node_of_founder[best.nodes.get(n).first_observation] = n;
+  std::vector<LocationHypothesis> locations;
+  std::unordered_map<int, std::size_t> location_index;
+  for (std::size_t s = 0; s < states.size(); ++s) {
+    const int founder = states[s]->nodes.get(states[s]->currentNode()).first_observation;
+    auto [it, inserted] = location_index.emplace(founder, locations.size());
+    if (inserted) {
+      LocationHypothesis l;
+      l.founding_observation = founder;
+      auto b = best_node_of_founder.find(founder);
+      l.node_in_best = b == best_node_of_founder.end() ? -1 : b->second;
+      locations.push_back(l);
+    }
+    locations[it->second].probability += counts[s] / m;
+  }
+  std::stable_sort(
+      locations.begin(), locations.end(),
+      [](const LocationHypothesis& a, const LocationHypothesis& b) { return a.probability > b.probability; });
+  const int best_founder = best.nodes.get(best.currentNode()).first_observation;
+  for (const auto& l : locations) {
+    if (l.founding_observation == best_founder) out.current_node_probability = l.probability;
+  }
+  out.locations = std::move(locations);
+  return out;
+}
+
+TopologyMemoryStats TopologyParticleFilter::memoryStats() const {
+  TopologyMemoryStats stats;
+  std::unordered_set<const TopologyState*> states;
+  std::unordered_set<const HistoryRecord*> records;
+  std::unordered_set<const TrieNode*> trie;
+  for (const auto& p : particles_) {
+    if (!states.insert(p.get()).second) continue;
+    for (const HistoryRecord* r = p->record.get(); r && records.insert(r).second; r = r->parent.get()) {
+    }
+    countTrieNodes(p->nodes.root().get(), p->nodes.levels(), trie);
+  }
+  stats.distinct_states = states.size();
+  stats.history_records = records.size();
+  stats.trie_nodes = trie.size();
+  for (const auto& f : fingerprints_) stats.stored_fingerprints += f ? 1 : 0;
+  return stats;
+}
+
+// ---- state (de)serialisation ---------------------------------------------------------------------
+
+void TopologyParticleFilter::saveState(std::ostream& out) const {
+  if (phase_ != Phase::Idle)
+    throw std::logic_error("TopologyParticleFilter::saveState: a step is in progress");
+  BinaryWriter w;
+  w.i32(config_.particles);
+  w.f64(config_.alpha);
+  w.f64(config_.new_node_probability);
+  w.f64(config_.gamma_shape);
+  w.f64(config_.gamma_scale);
+  w.i32(config_.max_successors);
+  w.i32(config_.max_representatives_per_node);
+  w.u8(config_.forbid_return_to_previous ? 1 : 0);
+  w.u64(config_.seed);
+  std::ostringstream rng_text;
+  rng_text << rng_;
+  w.bytes(rng_text.str());
+  w.i32(observation_count_);
+  w.f64(last_ess_);
+  w.i64(degenerate_steps_);
+
+  std::uint32_t alive = 0;
+  for (const auto& f : fingerprints_) alive += f ? 1 : 0;
+  w.u32(alive);
+  for (std::size_t o = 0; o < fingerprints_.size(); ++o) {
+    if (!fingerprints_[o]) continue;
+    std::ostringstream blob;
+    writeFingerprint(blob, *fingerprints_[o]);
+    w.i32(static_cast<std::int32_t>(o));
+    w.bytes(blob.str());
+  }
+
+  // History records reachable from the particles, parents before children (observation ascending).
+  std::vector<const HistoryRecord*> records;
+  std::unordered_map<const HistoryRecord*, std::int32_t> id;
+  for (const auto& p : particles_) {
+    for (const HistoryRecord* r = p->record.get(); r && id.emplace(r, 0).second; r = r->parent.get()) {
+      records.push_back(r);
+    }
+  }
+  std::stable_sort(records.begin(), records.end(), [](const HistoryRecord* a, const HistoryRecord* b) {
+    return a->observation < b->observation;
+  });
+  for (std::size_t i = 0; i < records.size(); ++i) id[records[i]] = static_cast<std::int32_t>(i);
+  w.u32(static_cast<std::uint32_t>(records.size()));
+  for (const HistoryRecord* r : records) {
+    w.i32(r->parent ? id.at(r->parent.get()) : -1);
+    w.i32(r->observation);
+    w.i32(r->node);
+  }
+  w.u32(static_cast<std::uint32_t>(particles_.size()));
+  for (const auto& p : particles_) w.i32(p->record ? id.at(p->record.get()) : -1);
+  const std::string& data = w.data();
+  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+}
+
+std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
+    std::istream& in, const SimilarityMeasure& similarity) {
+  std::string data;
+  std::array<char, 65536> chunk{};
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    data.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  BinaryReader r(data);
+  TopologyFilterConfig config;
+  config.particles = r.i32("config");
+  config.alpha = r.f64("config");
+  config.new_node_probability = r.f64("config");
+  config.gamma_shape = r.f64("config");
+  config.gamma_scale = r.f64("config");
+  config.max_successors = r.i32("config");
+  config.max_representatives_per_node = r.i32("config");
+  config.forbid_return_to_previous = r.u8("config") != 0;
+  config.seed = r.u64("config");
+  if (const std::string problem = config.validate(); !problem.empty()) {
+    throw std::runtime_error("map data has an invalid filter config: " + problem);
+  }
+  auto filter = std::make_unique<TopologyParticleFilter>(config, similarity);
+  {
+    std::istringstream rng_text{std::string(r.bytes("random generator state"))};
+    rng_text >> filter->rng_;
+    if (rng_text.fail()) throw std::runtime_error("map data has a malformed random generator state");
+  }
+  const std::int32_t observations = r.i32("observation count");
+  // Every observation has a history record (12 bytes) on each particle's lineage: bound the count by the
+  // bytes left before allocating anything for it.
+  if (observations < 0 || static_cast<std::uint64_t>(observations) > r.remaining() / 12) {
+    throw std::runtime_error("map data has an impossible observation count " + std::to_string(observations));
+  }
+  filter->observation_count_ = observations;
+  filter->stamp_ = static_cast<std::uint64_t>(observations);
+  filter->last_ess_ = r.f64("effective sample size");
+  filter->degenerate_steps_ = r.i64("degenerate steps");
+
+  const std::uint32_t alive = r.u32("fingerprint count");
+  if (alive > static_cast<std::uint32_t>(observations))
+    throw std::runtime_error("map data has more fingerprints than observations");
+  filter->fingerprints_.assign(idx(observations), nullptr);
+  for (std::uint32_t k = 0; k < alive; ++k) {
+    const std::int32_t o = r.i32("fingerprint index");
+    if (o < 0 || o >= observations || filter->fingerprints_[idx(o)]) {
+      throw std::runtime_error("map data has a bad fingerprint index " + std::to_string(o));
+    }
+    std::istringstream blob{std::string(r.bytes("fingerprint"))};
+    auto fingerprint = std::make_shared<Fingerprint>();
+    try {
+      *fingerprint = readFingerprint(blob);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("map data has a malformed fingerprint of observation " + std::to_string(o) +
+                               ": " + e.what());
+    }
+    if (const std::string problem = fingerprint->validate(); !problem.empty()) {
+      throw std::runtime_error("map data has an invalid fingerprint of observation " + std::to_string(o) +
+                               ": " + problem);
+    }
+    filter->fingerprints_[idx(o)] = std::move(fingerprint);
+  }
+
+  const std::uint32_t record_count = r.u32("history record count");
+  if (record_count > r.remaining() / 12) throw std::runtime_error("map data truncated in history records");
+  struct Rec {
+    std::int32_t parent, observation, node;
+  };
+  std::vector<Rec> recs(record_count);
+  std::vector<std::int32_t> remaining_children(record_count, 0);
+  for (std::uint32_t i = 0; i < record_count; ++i) {
+    Rec& rec = recs[i];
+    rec.parent = r.i32("history record");
+    rec.observation = r.i32("history record");
+    rec.node = r.i32("history record");
+    const bool root_ok = rec.parent == -1 && rec.observation == 0;
+    const bool child_ok = rec.parent >= 0 && static_cast<std::uint32_t>(rec.parent) < i &&
+                          rec.observation == recs[idx(rec.parent)].observation + 1;
+    if (!(root_ok || child_ok) || rec.observation >= observations) {
+      throw std::runtime_error("map data has an inconsistent history record " + std::to_string(i));
+    }
+    if (rec.parent >= 0) ++remaining_children[idx(rec.parent)];
+  }
+  const std::uint32_t particle_count = r.u32("particle count");
+  if (particle_count != static_cast<std::uint32_t>(config.particles)) {
+    throw std::runtime_error("map data has " + std::to_string(particle_count) + " particles, config says " +
+                             std::to_string(config.particles));
+  }
+  std::vector<std::int32_t> tips(particle_count);
+  std::vector<unsigned char> is_tip(record_count, 0);
+  for (auto& t : tips) {
+    t = r.i32("particles");
+    const bool ok = observations == 0 ? t == -1
+                                      : (t >= 0 && static_cast<std::uint32_t>(t) < record_count &&
+                                         recs[idx(t)].observation == observations - 1);
+    if (!ok) throw std::runtime_error("map data has a particle pointing at a bad history record");
+    if (t >= 0) is_tip[idx(t)] = 1;
+  }
+  if (!r.atEnd()) throw std::runtime_error("map data has trailing bytes after the particles");
+
+  // Rebuild the shared states by replaying the record tree (extendState is what the filter ran).
+  std::vector<std::shared_ptr<const TopologyState>> states(record_count);
+  const auto empty = std::make_shared<const TopologyState>();
+  for (std::uint32_t i = 0; i < record_count; ++i) {
+    const Rec& rec = recs[i];
+    const TopologyState& parent = rec.parent < 0 ? *empty : *states[idx(rec.parent)];
+    if (rec.node < 0 || rec.node > parent.nodeCount()) {
+      throw std::runtime_error("map data assigns observation " + std::to_string(rec.observation) +
+                               " to a node that does not exist");
+    }
+    states[i] = topology_detail::extendState(parent, rec.observation, rec.node, config);
+    if (rec.parent >= 0 && --remaining_children[idx(rec.parent)] == 0 && !is_tip[idx(rec.parent)]) {
+      states[idx(rec.parent)].reset();
+    }
+  }
+  for (std::uint32_t p = 0; p < particle_count; ++p) {
+    filter->particles_[p] = tips[p] < 0 ? empty : states[idx(tips[p])];
+  }
+  // Every representative a particle refers to must have come with the file.
+  std::vector<unsigned char> needed(idx(observations), 0);
+  ++filter->stamp_;
+  for (const auto& p : filter->particles_)
+    markReferenced(p->nodes.root().get(), p->nodes.levels(), filter->stamp_, needed);
+  for (std::size_t o = 0; o < needed.size(); ++o) {
+    if (needed[o] && !filter->fingerprints_[o]) {
+      throw std::runtime_error("map data lacks the fingerprint of observation " + std::to_string(o));
+    }
+  }
+  return filter;
+}
+
+}  // namespace toposlam

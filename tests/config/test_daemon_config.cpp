@@ -1,0 +1,210 @@
+// DaemonConfig: the shipped config/toposlam.yaml equals the defaults in code; unknown keys, wrong types and
+// out-of-range values are refused with the key's full dotted name and the allowed range.
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "toposlam/config/daemon_config.hpp"
+
+using namespace toposlam;
+
+namespace {
+
+std::string errorOf(const std::string& yaml) {
+  try {
+    parseDaemonConfig(yaml, "test.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+SCENARIO("The shipped config documents the defaults in code") {
+  GIVEN("config/toposlam.yaml") {
+    const DaemonConfig shipped = loadDaemonConfig(TOPOSLAM_SOURCE_DIR "/config/toposlam.yaml");
+    const DaemonConfig defaults;
+    THEN("it loads and every value equals the default in code") {
+      CHECK(shipped.validate().empty());
+      CHECK(shipped.source == defaults.source);
+      CHECK(shipped.source == "sim:office?route=loop2");
+      CHECK(shipped.lcm.url == "udpm://239.255.76.67:7667?ttl=0");
+      CHECK(shipped.lcm.place_channel == "TOPOSLAM_PLACE");
+      CHECK(shipped.lcm.place_event_channel == "TOPOSLAM_PLACE_EVENT");
+      CHECK(shipped.lcm.topology_channel == "TOPOSLAM_TOPOLOGY");
+      CHECK(shipped.lcm.status_channel == "TOPOSLAM_STATUS");
+      CHECK(shipped.lcm.motion_channel == "TOPOSLAM_MOTION");
+      CHECK(shipped.lcm.jpeg_quality == defaults.lcm.jpeg_quality);
+      CHECK(shipped.pipeline.map_path == defaults.pipeline.map_path);
+      CHECK(shipped.pipeline.map_save_period_s == defaults.pipeline.map_save_period_s);
+      CHECK(shipped.load_map_at_start == defaults.load_map_at_start);
+      CHECK(shipped.watchdog == defaults.watchdog);
+      CHECK(shipped.pipeline.heartbeat_timeout_s == defaults.pipeline.heartbeat_timeout_s);
+      CHECK(shipped.pipeline.queues.frames == defaults.pipeline.queues.frames);
+      CHECK(shipped.pipeline.queues.fingerprints == defaults.pipeline.queues.fingerprints);
+      CHECK(shipped.pipeline.queues.segmented == defaults.pipeline.queues.segmented);
+      CHECK(shipped.pipeline.queues.results == defaults.pipeline.queues.results);
+      CHECK(shipped.pipeline.queues.overflow == defaults.pipeline.queues.overflow);
+      CHECK(shipped.pipeline.threads.capture.name == defaults.pipeline.threads.capture.name);
+      CHECK(shipped.pipeline.threads.publisher.name == defaults.pipeline.threads.publisher.name);
+      CHECK(shipped.pipeline.filter_budget_ms == defaults.pipeline.filter_budget_ms);
+      CHECK(shipped.pipeline.status_period_s == defaults.pipeline.status_period_s);
+      CHECK(shipped.pipeline.thumbnail_width == defaults.pipeline.thumbnail_width);
+      CHECK(shipped.fingerprint_workers == defaults.fingerprint_workers);
+      CHECK(shipped.fingerprint.edges.mean_factor == defaults.fingerprint.edges.mean_factor);
+      CHECK(shipped.fingerprint.edges.opening_height_fraction == defaults.fingerprint.edges.opening_height_fraction);
+      CHECK(shipped.fingerprint.edges.dilation_width == defaults.fingerprint.edges.dilation_width);
+      CHECK(shipped.fingerprint.edges.min_separation_fraction == defaults.fingerprint.edges.min_separation_fraction);
+      CHECK(shipped.fingerprint.histogram.achromatic_chroma == defaults.fingerprint.histogram.achromatic_chroma);
+      CHECK(shipped.fingerprint.keypoints.backend == defaults.fingerprint.keypoints.backend);
+      CHECK(shipped.fingerprint.keypoints.max_keypoints == defaults.fingerprint.keypoints.max_keypoints);
+      CHECK(shipped.fingerprint.keypoints.candidate_limit == defaults.fingerprint.keypoints.candidate_limit);
+      CHECK(shipped.fingerprint.keypoints.orb_levels == defaults.fingerprint.keypoints.orb_levels);
+      CHECK(shipped.fingerprint.keypoints.orb_fast_threshold == defaults.fingerprint.keypoints.orb_fast_threshold);
+      CHECK(shipped.similarity.matcher.max_hellinger_distance == defaults.similarity.matcher.max_hellinger_distance);
+      CHECK(shipped.similarity.matcher.ratio_test == defaults.similarity.matcher.ratio_test);
+      CHECK(shipped.similarity.histogram_weight == defaults.similarity.histogram_weight);
+      CHECK(shipped.segmentation.window == defaults.segmentation.window);
+      CHECK(shipped.segmentation.valley.gamma == defaults.segmentation.valley.gamma);
+      CHECK(shipped.segmentation.valley.delta == defaults.segmentation.valley.delta);
+      CHECK(shipped.segmentation.min_keypoints == defaults.segmentation.min_keypoints);
+      CHECK(shipped.segmentation.cut_placement == defaults.segmentation.cut_placement);
+      CHECK(shipped.topology.particles == defaults.topology.particles);
+      CHECK(shipped.topology.alpha == defaults.topology.alpha);
+      CHECK(shipped.topology.new_node_probability == defaults.topology.new_node_probability);
+      CHECK(shipped.topology.gamma_shape == defaults.topology.gamma_shape);
+      CHECK(shipped.topology.gamma_scale == defaults.topology.gamma_scale);
+      CHECK(shipped.topology.max_successors == defaults.topology.max_successors);
+      CHECK(shipped.topology.max_representatives_per_node == defaults.topology.max_representatives_per_node);
+      CHECK(shipped.topology.seed == defaults.topology.seed);
+      CHECK(shipped.topology_slice_items == defaults.topology_slice_items);
+      CHECK(shipped.topology_alternatives == defaults.topology_alternatives);
+    }
+  }
+  GIVEN("an empty document") {
+    THEN("it means all defaults") { CHECK(parseDaemonConfig("", "empty").source == DaemonConfig{}.source); }
+  }
+}
+
+SCENARIO("Values given in the file override the defaults") {
+  const DaemonConfig c = parseDaemonConfig(R"(
+source: "images:/data/run1?rate=5"
+lcm: {url: "udpm://239.255.76.67:7667?ttl=1", channels: {place: ROBOT1_PLACE}}
+map: {path: /var/lib/toposlam/office.tsm, save_period_s: 0, load_at_start: false}
+pipeline:
+  queues: {frames: 4, overflow: block}
+  threads: {topology: {name: my-filter, cpu: 1, policy: fifo, priority: 20}}
+  filter_budget_ms: 7.5
+fingerprint: {workers: 1, keypoints: {backend: sift, max_keypoints: 200}}
+segmentation: {window: 31, cut_placement: valley-frame}
+topology: {particles: 200, seed: 42}
+)");
+  CHECK(c.source == "images:/data/run1?rate=5");
+  CHECK(c.lcm.url == "udpm://239.255.76.67:7667?ttl=1");
+  CHECK(c.lcm.place_channel == "ROBOT1_PLACE");
+  CHECK(c.lcm.status_channel == "TOPOSLAM_STATUS");
+  CHECK(c.pipeline.map_path == "/var/lib/toposlam/office.tsm");
+  CHECK(c.pipeline.map_save_period_s == 0.0);
+  CHECK_FALSE(c.load_map_at_start);
+  CHECK(c.pipeline.queues.frames == 4);
+  CHECK(c.pipeline.queues.overflow == QueueOverflow::Block);
+  CHECK(c.pipeline.threads.topology.name == "my-filter");
+  CHECK(c.pipeline.threads.topology.cpu == 1);
+  CHECK(c.pipeline.threads.topology.policy == SchedulingPolicy::Fifo);
+  CHECK(c.pipeline.threads.topology.priority == 20);
+  CHECK(c.pipeline.filter_budget_ms == 7.5);
+  CHECK(c.fingerprint_workers == 1);
+  CHECK(c.fingerprint.keypoints.backend == KeypointBackend::Sift);
+  CHECK(c.fingerprint.keypoints.max_keypoints == 200);
+  CHECK(c.segmentation.window == 31);
+  CHECK(c.segmentation.cut_placement == CutPlacement::ValleyFrame);
+  CHECK(c.topology.particles == 200);
+  CHECK(c.topology.seed == 42u);
+}
+
+SCENARIO("Bad configs are refused with the key's full name and the allowed range") {
+  // (yaml, the error must contain this)
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"sourse: x", "unknown key 'sourse'"},
+      {"pipeline: {queues: {framez: 2}}", "unknown key 'pipeline.queues.framez'"},
+      {"pipeline: {threads: {capture: {prio: 1}}}", "unknown key 'pipeline.threads.capture.prio'"},
+      {"pipeline: {threads: {gpu: {}}}", "unknown key 'pipeline.threads.gpu'"},
+      {"pipeline: {queues: {frames: 0}}", "pipeline.queues.frames: 0 is out of range, allowed 1 .. 1024"},
+      {"pipeline: {queues: {results: 5000}}", "pipeline.queues.results: 5000 is out of range, allowed 1 .. 1024"},
+      {"pipeline: {queues: {overflow: drop_newest}}", "pipeline.queues.overflow: 'drop_newest' is not allowed, expected one of: drop_oldest, block"},
+      {"pipeline: {filter_budget_ms: 0}", "pipeline.filter_budget_ms: 0 is out of range, allowed [0.1, 1000] milliseconds"},
+      {"pipeline: {status_period_s: 120}", "pipeline.status_period_s: 120 is out of range, allowed [0.1, 60] seconds"},
+      {"pipeline: {thumbnail_width: 8}", "pipeline.thumbnail_width: 8 is out of range, allowed 16 .. 1280 pixels"},
+      {"pipeline: {threads: {capture: {name: this-name-is-too-long}}}", "pipeline.threads.capture.name: must have 1 to 15 characters"},
+      {"pipeline: {threads: {capture: {cpu: -5}}}", "pipeline.threads.capture.cpu: -5 is out of range, allowed -1 .. 1023"},
+      {"pipeline: {threads: {publisher: {policy: fifo}}}", "pipeline.threads.publisher.priority: 0 is out of range for policy fifo, allowed 1 .. 99"},
+      {"pipeline: {threads: {segmentation: {policy: rr}}}", "pipeline.threads.segmentation.policy: 'rr' is not allowed, expected one of: other, fifo"},
+      {"map: {save_period_s: -1}", "map.save_period_s: -1 is out of range, allowed [0, 86400] seconds"},
+      {"map: {save_period_s: 0.5}", "map.save_period_s: 0.5"},
+      {"map: {load_at_start: maybe}", "map.load_at_start: expected true or false, got 'maybe'"},
+      {"watchdog: {heartbeat_timeout_s: 0.1}", "watchdog.heartbeat_timeout_s: 0.1 is out of range, allowed [0.5, 600] seconds"},
+      {"lcm: {jpeg_quality: 101}", "lcm.jpeg_quality: 101 is out of range, allowed 1 .. 100"},
+      {"lcm: {channels: {status: \"\"}}", "lcm.channels.status: must have 1 to 255 characters"},
+      {"lcm: {url: [a, b]}", "lcm.url: expected a string, got a list"},
+      {"fingerprint: {workers: 0}", "fingerprint.workers: 0 is out of range, allowed 1 .. 64"},
+      {"fingerprint: {edges: {mean_factor: 0}}", "fingerprint.edges.mean_factor: 0 is out of range, allowed (0, 100]"},
+      {"fingerprint: {histogram: {achromatic_chroma: 1}}", "fingerprint.histogram.achromatic_chroma: 1 is out of range, allowed [0, 1)"},
+      {"fingerprint: {histogram: {min_lightness: 0.6, max_lightness: 0.5}}", "fingerprint.histogram.max_lightness: 0.5 is out of range"},
+      {"fingerprint: {keypoints: {backend: surf}}", "fingerprint.keypoints.backend: 'surf' is not allowed, expected one of: orb, sift, brisk, akaze"},
+      {"fingerprint: {keypoints: {max_keypoints: 500, candidate_limit: 100}}", "fingerprint.keypoints.candidate_limit: 100 is out of range, allowed max_keypoints (500) .. 100000"},
+      {"fingerprint: {keypoints: {max_keypoints: 1.5}}", "fingerprint.keypoints.max_keypoints: expected an integer in 0 .. 10000, got '1.5'"},
+      {"similarity: {matcher: {max_hellinger_distance: 0}}", "similarity.matcher.max_hellinger_distance: 0 is out of range, allowed (0, 1]"},
+      {"similarity: {histogram_weight: 2}", "similarity.histogram_weight: 2 is out of range, allowed [0, 1]"},
+      {"segmentation: {window: 2}", "segmentation.window: 2 is out of range, allowed 3 .. 1000 frames"},
+      {"segmentation: {valley: {gamma: 0.2, delta: 0.3}}", "segmentation.valley.delta: 0.3 is out of range, allowed [0, gamma = 0.2]"},
+      {"segmentation: {window: 3, valley: {gamma: 1.6}}", "segmentation.valley.gamma: 1.6 is out of range, allowed [0, window / (window - 1) = 1.5]"},
+      {"segmentation: {cut_placement: middle}", "segmentation.cut_placement: 'middle' is not allowed"},
+      {"topology: {particles: 0}", "topology.particles: 0 is out of range, allowed 1 .. 1000000"},
+      {"topology: {particles: lots}", "topology.particles: expected an integer in 1 .. 1000000, got 'lots'"},
+      {"topology: {new_node_probability: 1}", "topology.new_node_probability: 1 is out of range, allowed (0, 1)"},
+      {"topology: {max_successors: 9}", "topology.max_successors: 9 is out of range, allowed 1 .. 8"},
+      {"topology: {seed: -1}", "topology.seed: -1 is out of range"},
+      {"topology: {slice_items: 0}", "topology.slice_items: 0 is out of range, allowed 1 .. 1000000 work items"},
+      {"topology: {alpha: .nan}", "topology.alpha: nan is out of range, allowed (0, 1e+06]"},
+      {"pipeline: 3", "pipeline: expected a mapping of keys, got '3'"},
+      {"map: {path: }", "map.path: has no value"},
+      {"[1, 2]", "top level: expected a mapping of keys, got a list"},
+      {"pipeline: {queues: {frames: 2", "test.yaml: not valid YAML"},
+  };
+  for (const auto& [yaml, expected] : cases) {
+    GIVEN(yaml) {
+      const std::string error = errorOf(yaml);
+      THEN("the error names it: " + expected) {
+        CHECK_THAT(error, Catch::Contains(expected));
+        CHECK_THAT(error, Catch::StartsWith("test.yaml: "));
+      }
+    }
+  }
+}
+
+SCENARIO("A config file that cannot be read is refused with its path") {
+  CHECK_THROWS_WITH(loadDaemonConfig("/nonexistent/toposlam.yaml"),
+                    Catch::Contains("cannot read the config file '/nonexistent/toposlam.yaml'"));
+}
+
+SCENARIO("DaemonConfig::validate() names keys by their YAML path") {
+  DaemonConfig c;
+  CHECK(c.validate().empty());
+  c.pipeline.map_save_period_s = 0.5;
+  CHECK_THAT(c.validate(), Catch::StartsWith("map.save_period_s: 0.5"));
+  c = DaemonConfig{};
+  c.pipeline.heartbeat_timeout_s = 0;
+  CHECK_THAT(c.validate(), Catch::StartsWith("watchdog.heartbeat_timeout_s: "));
+  c = DaemonConfig{};
+  c.pipeline.queues.segmented = 0;
+  CHECK_THAT(c.validate(), Catch::StartsWith("pipeline.queues.segmented: "));
+  c = DaemonConfig{};
+  c.topology.particles = 0;
+  CHECK_THAT(c.validate(), Catch::StartsWith("topology."));
+  c = DaemonConfig{};
+  c.source.clear();
+  CHECK_THAT(c.validate(), Catch::StartsWith("source: must not be empty"));
+}

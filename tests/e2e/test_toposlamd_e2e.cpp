@@ -1,0 +1,294 @@
+// End to end: toposlamd on the simulated two-traversal office, heard over real LCM UDP multicast (run by
+// in_netns.sh inside a private network namespace). Checks the place messages (nodes map to rooms, the loop
+// is closed), READY/WATCHDOG on a fake NOTIFY_SOCKET, and that SIGTERM mid-run saves a map that resumes.
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "toposlam/io/sim_source.hpp"
+#include "toposlam/io/source_uri.hpp"
+#include "toposlam/platform/lcm_transport.hpp"
+
+namespace fs = std::filesystem;
+using namespace toposlam;
+
+namespace {
+
+const std::string kLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+const std::string kRoute = "sim:office?route=loop2";
+
+/// A unix datagram socket standing in for systemd's notify socket (non-blocking reads).
+class FakeNotifySocket {
+ public:
+  explicit FakeNotifySocket(const fs::path& path) : path_(path.string()) {
+    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    path_.copy(address.sun_path, sizeof(address.sun_path) - 1);
+    if (fd_ < 0 || bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0)
+      throw std::runtime_error("cannot bind " + path_);
+  }
+  ~FakeNotifySocket() { close(fd_); }
+  /// Everything received so far, one datagram per entry.
+  std::vector<std::string> drain() {
+    std::vector<std::string> out;
+    char buffer[4096];
+    for (ssize_t n; (n = recv(fd_, buffer, sizeof buffer, 0)) > 0;) out.emplace_back(buffer, static_cast<std::size_t>(n));
+    return out;
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
+/// toposlamd as a child process.
+class Daemon {
+ public:
+  Daemon(const std::vector<std::string>& args, const std::string& notify_socket, const fs::path& log) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      if (!notify_socket.empty()) {
+        setenv("NOTIFY_SOCKET", notify_socket.c_str(), 1);
+        setenv("WATCHDOG_USEC", "1000000", 1);
+        setenv("WATCHDOG_PID", std::to_string(getpid()).c_str(), 1);
+      }
+      std::vector<char*> argv;
+      const std::string binary = TOPOSLAMD_BINARY;
+      argv.push_back(const_cast<char*>(binary.c_str()));
+      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(binary.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+  ~Daemon() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  void terminate() { kill(pid_, SIGTERM); }
+  /// Exit status once the process ended, else -1 (non-blocking).
+  int poll() {
+    if (exited_) return status_;
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    return exited_ ? status_ : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  int status_ = -1;
+};
+
+struct Heard {
+  std::vector<ReceivedMessage> places, events, statuses, topologies;
+};
+
+/// Listens until the daemon exits (or `deadline_s`), calling `each` after every batch; returns the exit code.
+template <typename Each>
+int listenUntilExit(LcmSubscriber& subscriber, Daemon& daemon, double deadline_s, Each each) {
+  const auto start = std::chrono::steady_clock::now();
+  int code = -1;
+  while ((code = daemon.poll()) < 0) {
+    subscriber.handle(50);
+    each();
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > deadline_s) return -2;
+  }
+  for (int i = 0; i < 5; ++i) subscriber.handle(20);  // late datagrams
+  return code;
+}
+
+fs::path freshDirectory(const std::string& name) {
+  fs::path dir = fs::path(TOPOSLAM_BINARY_DIR) / "e2e" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::unique_ptr<LcmSubscriber> subscribe(Heard& heard) {
+  const LcmChannels channels;
+  return std::make_unique<LcmSubscriber>(
+      kLcmUrl, channels,
+      std::vector<std::string>{channels.place, channels.place_event, channels.status, channels.topology},
+      [&heard](const ReceivedMessage& m) {
+        if (m.kind == "place") heard.places.push_back(m);
+        if (m.kind == "place_event") heard.events.push_back(m);
+        if (m.kind == "status") heard.statuses.push_back(m);
+        if (m.kind == "topology") heard.topologies.push_back(m);
+      });
+}
+
+bool contains(const std::vector<std::string>& lines, const std::string& text) {
+  for (const std::string& l : lines)
+    if (l.find(text) != std::string::npos) return true;
+  return false;
+}
+
+/// Representative frame of a place event, from its JSON.
+std::int64_t representativeOf(const ReceivedMessage& m) {
+  const std::string key = "\"representative_frame\":";
+  const std::size_t at = m.json.find(key);
+  return at == std::string::npos ? -1 : std::stoll(m.json.substr(at + key.size()));
+}
+
+}  // namespace
+
+/// One run of toposlamd over the whole route, shared by the sections below (Catch re-enters the scenario
+/// once per THEN; the daemon runs once).
+struct OfficeRun {
+  int code = -1;
+  bool map_saved = false;
+  std::vector<std::string> notifications;
+  Heard heard;
+  std::int64_t frames = 0;
+  std::vector<int> event_rooms;  ///< ground-truth room of each place event's representative (-1: doorway)
+};
+
+const OfficeRun& officeRun() {
+  static const OfficeRun run = [] {
+    OfficeRun r;
+    const fs::path dir = freshDirectory("office");
+    FakeNotifySocket notify(dir / "notify.sock");
+    auto subscriber = subscribe(r.heard);
+    Daemon daemon({"--source", kRoute + "&rate=250", "--overflow", "block", "--map", (dir / "map.tsm").string(),
+                   "--no-map-load", "--lcm-url", kLcmUrl},
+                  notify.path(), dir / "toposlamd.log");
+    r.code = listenUntilExit(*subscriber, daemon, 100.0, [&] {
+      for (std::string& n : notify.drain()) r.notifications.push_back(std::move(n));
+    });
+    for (std::string& n : notify.drain()) r.notifications.push_back(std::move(n));
+    r.map_saved = fs::exists(dir / "map.tsm");
+    sim::Simulator truth(simConfigFromUri(parseSourceUri(kRoute)));
+    r.frames = truth.frameCount();
+    for (const ReceivedMessage& e : r.heard.events) r.event_rooms.push_back(truth.truthOf(representativeOf(e)).room);
+    return r;
+  }();
+  return run;
+}
+
+SCENARIO("toposlamd maps the simulated two-traversal office and publishes it over LCM multicast") {
+  GIVEN("toposlamd on sim:office?route=loop2 (lossless queues), a fake NOTIFY_SOCKET with a 1 s watchdog") {
+    const OfficeRun& run = officeRun();
+    const Heard& heard = run.heard;
+    THEN("it ran to the end of the route, exited 0 and saved the map") {
+      CHECK(run.code == 0);
+      CHECK(run.map_saved);
+    }
+    THEN("systemd would have seen READY=1, STATUS= lines and watchdog pings") {
+      CHECK(contains(run.notifications, "READY=1"));
+      CHECK(contains(run.notifications, "STATUS=running"));
+      CHECK(contains(run.notifications, "WATCHDOG=1"));
+    }
+    THEN("a place message arrived for (nearly) every frame, in order") {
+      // UDP may lose a datagram under load; the daemon itself drops nothing in block mode.
+      CHECK(static_cast<double>(heard.places.size()) >= 0.95 * static_cast<double>(run.frames));
+      for (std::size_t i = 1; i < heard.places.size(); ++i) CHECK(heard.places[i].frame > heard.places[i - 1].frame);
+      REQUIRE_FALSE(heard.statuses.empty());
+      CHECK_THAT(heard.statuses.back().json, Catch::Contains("\"state\":\"finished\""));
+    }
+    THEN("places map to rooms: each node's places are mostly one room, and the loop is closed") {
+      REQUIRE(heard.events.size() >= 8);
+      CHECK_THAT(heard.events.front().json, Catch::Contains("\"place\":0,\"node\":0,\"is_new\":true"));
+      std::map<int, std::map<int, int>> rooms_of_node;  // node -> room -> places
+      std::map<int, int> first_room_of_node;
+      int revisits = 0, revisits_same_room = 0, labelled = 0;
+      for (std::size_t i = 0; i < heard.events.size(); ++i) {
+        const ReceivedMessage& e = heard.events[i];
+        const int room = run.event_rooms[i];
+        if (room < 0) continue;  // representative in a doorway
+        ++labelled;
+        ++rooms_of_node[e.node][room];
+        if (!e.is_new) {
+          ++revisits;
+          if (first_room_of_node.count(e.node) && first_room_of_node[e.node] == room) ++revisits_same_room;
+        }
+        first_room_of_node.emplace(e.node, room);
+      }
+      int majority = 0;
+      for (const auto& [node, rooms] : rooms_of_node) {
+        int best = 0;
+        for (const auto& [room, count] : rooms) best = std::max(best, count);
+        majority += best;
+      }
+      INFO("places with a room label: " << labelled << ", in their node's majority room: " << majority
+                                        << ", revisits: " << revisits << " (" << revisits_same_room << " same room)");
+      CHECK(static_cast<double>(majority) >= 0.8 * labelled);
+      CHECK(revisits >= 3);                          // the second traversal re-used nodes
+      CHECK(2 * revisits_same_room >= revisits);     // at least half of them in the room the node was made in
+    }
+  }
+}
+
+SCENARIO("SIGTERM mid-run saves the map, and the next start resumes from it") {
+  GIVEN("toposlamd stopped by SIGTERM after its third place") {
+    const fs::path dir = freshDirectory("resume");
+    const fs::path map = dir / "map.tsm";
+    Heard first;
+    int code = -1;
+    {
+      auto subscriber = subscribe(first);
+      Daemon daemon({"--source", kRoute + "&rate=150", "--overflow", "block", "--map", map.string(), "--no-map-load",
+                     "--lcm-url", kLcmUrl},
+                    "", dir / "first.log");
+      bool sent = false;
+      code = listenUntilExit(*subscriber, daemon, 100.0, [&] {
+        if (!sent && first.events.size() >= 3) {
+          daemon.terminate();
+          sent = true;
+        }
+      });
+    }
+    THEN("it exits 0 before the end of the route, with every closed place stepped and the map saved") {
+      CHECK(code == 0);
+      REQUIRE(fs::exists(map));
+      REQUIRE_FALSE(first.statuses.empty());
+      CHECK_THAT(first.statuses.back().json, Catch::Contains("\"maps_saved\":1"));
+      CHECK(first.places.size() < 1600);
+    }
+    WHEN("toposlamd starts again with the same map") {
+      Heard second;
+      auto subscriber = subscribe(second);
+      Daemon daemon({"--source", kRoute + "&rate=250", "--overflow", "block", "--map", map.string(), "--lcm-url",
+                     kLcmUrl},
+                    "", dir / "second.log");
+      bool sent = false;
+      const int second_code = listenUntilExit(*subscriber, daemon, 100.0, [&] {
+        if (!sent && !second.events.empty()) {
+          daemon.terminate();
+          sent = true;
+        }
+      });
+      THEN("place numbering continues from the saved map and the start room is recognised") {
+        CHECK(second_code == 0);
+        REQUIRE_FALSE(second.events.empty());
+        const int saved_places = static_cast<int>(first.events.size());
+        CHECK(second.events.front().place == saved_places);
+        // The route starts in the same room again: its node is one the saved map already had.
+        CHECK_FALSE(second.events.front().is_new);
+        CHECK(second.events.front().node == first.events.front().node);
+      }
+    }
+  }
+}

@@ -1,0 +1,123 @@
+// A whole run folder against labels, a pairs CSV and bad truth: the numbers are worked out by hand from
+// the fixture in eval_fixture.hpp.
+#include <catch2/catch.hpp>
+
+#include <sstream>
+
+#include "eval_fixture.hpp"
+#include "toposlam/eval/evaluation.hpp"
+#include "toposlam/eval/json_reader.hpp"
+
+using namespace toposlam::eval;
+using namespace toposlam::eval::testing;
+using Catch::Matchers::Contains;
+
+SCENARIO(
+    "GIVEN the fixture map run and its labels WHEN evaluated THEN every table holds the hand-computed "
+    "numbers") {
+  const auto dir = writeFixtureRun("labels");
+  const RunData run = loadRun(dir.string());
+  CHECK(run.traversal_starts == std::vector<std::int64_t>{0});
+  const Truth truth = loadTruth((dir / "labels.csv").string());
+  REQUIRE(truth.kind == Truth::Kind::Labels);
+  const EvalResult r = evaluate(run, truth, EvalOptions{});
+  CHECK(r.frames == 10);
+  CHECK(r.places == 3);
+  CHECK(r.min_gap == 0);
+
+  REQUIRE(r.localisation);
+  // 9 frames with a room: p = 1 (frames 0-2), 0.95 (4, 5), 0.6 (6-9); all on the node of their room.
+  CHECK((*r.localisation)[0].images == 9);
+  CHECK((*r.localisation)[1].images == 9);
+  CHECK((*r.localisation)[2].images == 5);
+  CHECK((*r.localisation)[4].precision == Approx(1.0));
+
+  REQUIRE(r.loop_closure);
+  // Room 0 visited at frames 0-2 and 6-9: 12 positive pairs, all predicted at p = 0.6.
+  CHECK(r.loop_closure->positives == 12);
+  CHECK(r.loop_closure->predicted == 12);
+  CHECK(r.loop_closure->recall_at_full_precision == Approx(1.0));
+
+  REQUIRE(r.boundaries);
+  // Truth: doorway [3, 4] and [6, 6]; cuts at 3 and 6.
+  CHECK(r.boundaries->truth == 2);
+  CHECK(r.boundaries->predicted == 2);
+  CHECK(r.boundaries->f1 == Approx(1.0));
+  REQUIRE(r.places_per_traversal);
+  CHECK((*r.places_per_traversal)[0].places == 3);
+  CHECK((*r.places_per_traversal)[0].room_visits == 3);
+
+  REQUIRE(r.topology);
+  CHECK(r.topology->nodes == 2);
+  CHECK(r.topology->one_to_one == 2);
+  CHECK(r.topology->loop_closures == 1);
+  CHECK(r.topology->wrong_loop_closures == 0);
+  CHECK(r.best_topology_probability == std::vector<double>{1.0, 0.95, 0.7});
+
+  WHEN("written as eval.json and read back") {
+    std::ostringstream json;
+    writeEvalJson(json, r);
+    const JsonValue v = parseJson(json.str(), "eval.json");
+    THEN("the numbers survive") {
+      CHECK(v.at("loop_closure").at("recall_at_100_precision").asNumber() == Approx(1.0));
+      CHECK(v.at("segmentation").at("f1").asNumber() == Approx(1.0));
+      CHECK(v.at("topology").at("nodes").asNumber() == 2);
+      CHECK(v.at("localisation").asArray().size() == 5);
+    }
+  }
+  WHEN("formatted as text and HTML") {
+    const std::string text = formatEvalText(r);
+    const std::string html = formatEvalHtml(r);
+    THEN("the tables are there") {
+      CHECK_THAT(text, Contains("recall at 100% precision"));
+      CHECK_THAT(text, Contains("100.00%"));
+      CHECK_THAT(html, Contains("<table class=\"eval\">"));
+    }
+  }
+  WHEN("split into two traversals") {
+    EvalOptions two;
+    two.traversals = 2;
+    const EvalResult r2 = evaluate(run, truth, two);
+    THEN("places are counted per half") {
+      CHECK(r2.traversals == 2);
+      REQUIRE(r2.places_per_traversal->size() == 2);
+      CHECK((*r2.places_per_traversal)[0].places == 2);  // representatives 1 and 4 < 5
+      CHECK((*r2.places_per_traversal)[1].places == 1);
+    }
+  }
+}
+
+SCENARIO(
+    "GIVEN a pairs CSV naming frames WHEN evaluated with a gap of 2 frames THEN names resolve through "
+    "frames.csv") {
+  const auto dir = writeFixtureRun("pairs");
+  writeText(dir / "pairs.csv", "query_image,matching_images\ng.png,a.png b.png\n");
+  EvalOptions options;
+  options.min_gap = 2;
+  const EvalResult r = evaluate(loadRun(dir.string()), loadTruth((dir / "pairs.csv").string()), options);
+  REQUIRE(r.loop_closure);
+  // Node 0 holds frames 0-2 and 6-9: 12 cross pairs plus (9,6) are more than 2 frames apart; 2 are true.
+  CHECK(r.loop_closure->positives == 2);
+  CHECK(r.loop_closure->predicted == 13);
+  CHECK(r.loop_closure->recall_at_full_precision == Approx(0.0));
+  CHECK(r.loop_closure->points.back().precision == Approx(2.0 / 13.0));
+  CHECK_FALSE(r.localisation);
+  CHECK_FALSE(r.notes.empty());
+}
+
+SCENARIO(
+    "GIVEN ground truth that does not fit the run WHEN evaluated THEN the error says what does not fit") {
+  const auto dir = writeFixtureRun("misfit");
+  const RunData run = loadRun(dir.string());
+  writeText(dir / "short_labels.csv", "frame,time,room\n0,0,0\n");
+  CHECK_THROWS_WITH(evaluate(run, loadTruth((dir / "short_labels.csv").string()), {}),
+                    Contains("has 1 frames but"));
+  writeText(dir / "pairs.csv", "query,matches\nzzz.png,a.png\n");
+  CHECK_THROWS_WITH(evaluate(run, loadTruth((dir / "pairs.csv").string()), {}),
+                    Contains("pairs.csv:2: frame 'zzz.png' is not in"));
+  CHECK_THROWS_WITH(evaluate(run, loadTruth(std::string(TOPOSLAM_SAMPLES_DIR) + "/samples_GT.bmp"), {}),
+                    Contains("loop-closure matrix is 84x84 but"));
+  CHECK_THROWS_WITH(loadRun((dir / "nope").string()), Contains("not a run folder"));
+  const auto empty = scratchDir("empty-run");
+  CHECK_THROWS_WITH(loadRun(empty.string()), Contains("frames.csv: missing"));
+}

@@ -1,0 +1,184 @@
+// Evaluation measures on hand-made inputs whose answers are worked out by hand in the comments.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "toposlam/eval/metrics.hpp"
+
+using namespace toposlam::eval;
+
+SCENARIO(
+    "GIVEN six localisation predictions WHEN tabulated at the thesis thresholds THEN counts and precision "
+    "match Table 3.1's definition") {
+  // (predicted, truth, probability): correct at 0.95, 0.75, 0.55, 0.5; wrong at 0.85 and 0.45.
+  const std::vector<LocalisationPrediction> predictions = {{"A", "A", 0.95}, {"A", "B", 0.85},
+                                                           {"B", "B", 0.75}, {"B", "B", 0.55},
+                                                           {"C", "A", 0.45}, {"A", "A", 0.5}};
+  const auto rows = localisationTable(predictions, defaultThresholds());
+  REQUIRE(rows.size() == 5);
+  CHECK(rows[0].threshold == 0.5);
+  CHECK(rows[0].images == 5);  // 0.5 itself counts (>=)
+  CHECK(rows[0].correct == 4);
+  CHECK(rows[0].precision == Approx(0.8));
+  CHECK(rows[1].images == 3);
+  CHECK(rows[1].precision == Approx(2.0 / 3.0));
+  CHECK(rows[2].images == 3);
+  CHECK(rows[3].images == 2);
+  CHECK(rows[3].precision == Approx(0.5));
+  CHECK(rows[4].images == 1);
+  CHECK(rows[4].precision == Approx(1.0));
+  WHEN("no prediction reaches a threshold") {
+    const auto empty = localisationTable({{"A", "A", 0.3}}, {0.9});
+    THEN("it has 0 images and an undefined precision") {
+      CHECK(empty[0].images == 0);
+      CHECK(std::isnan(empty[0].precision));
+    }
+  }
+}
+
+SCENARIO(
+    "GIVEN rooms 0,1,0,1 (four visits) and nodes 0,1,0,0 WHEN the loop-closure curve is computed THEN recall "
+    "at 100 % precision is 0.5") {
+  // Positives: (2,0) and (3,1). Predicted pairs (same node 0): (2,0) score 0.9 TP, (3,0) and (3,2) score 0.4
+  // FP.
+  const LoopClosureTruth truth = truthFromRooms({0, 1, 0, 1}, 0);
+  CHECK(truth.positives() == 2);
+  CHECK(truth.at(1, 0) == 0);
+  CHECK(truth.at(0, 2) == 1);
+  const auto pairs = pairsFromAssignments({0, 1, 0, 0}, {1.0, 1.0, 0.9, 0.4});
+  CHECK(pairs.size() == 3);
+  const PrCurve curve = precisionRecall(truth, pairs);
+  REQUIRE(curve.points.size() == 2);
+  CHECK(curve.points[0].threshold == Approx(0.9));
+  CHECK(curve.points[0].true_positives == 1);
+  CHECK(curve.points[0].false_positives == 0);
+  CHECK(curve.points[0].precision == Approx(1.0));
+  CHECK(curve.points[0].recall == Approx(0.5));
+  CHECK(curve.points[1].false_positives == 2);
+  CHECK(curve.points[1].precision == Approx(1.0 / 3.0));
+  CHECK(curve.recall_at_full_precision == Approx(0.5));
+  CHECK(curve.threshold_at_full_precision == Approx(0.9));
+  CHECK(curve.average_precision == Approx(0.5));  // 0.5 x 1 + 0 x 1/3
+}
+
+SCENARIO(
+    "GIVEN one room visit split by a doorway WHEN loop-closure truth is built THEN pairs within a visit are "
+    "not evaluated") {
+  // rooms 0,0,1,1,0,0: visits {0,1}, {2,3}, {4,5}; positives (4,0),(4,1),(5,0),(5,1); (1,0),(3,2),(5,4)
+  // ignored.
+  const LoopClosureTruth truth = truthFromRooms({0, 0, 1, 1, 0, 0}, 0);
+  CHECK(truth.positives() == 4);
+  CHECK(truth.at(1, 0) == -1);
+  CHECK(truth.at(5, 4) == -1);
+  CHECK(truth.at(2, 0) == 0);
+  // Frames 0,1,4 on node 0: (1,0) is ignored, (4,0) and (4,1) are true positives at score 0.8.
+  const PrCurve curve =
+      precisionRecall(truth, pairsFromAssignments({0, 0, 1, 1, 0, 2}, {1, 1, 0.9, 0.9, 0.8, 0.6}));
+  REQUIRE(curve.points.size() == 1);
+  CHECK(curve.predicted == 2);
+  CHECK(curve.recall_at_full_precision == Approx(0.5));
+  WHEN("a pair lies outside the truth") {
+    THEN("it throws") { CHECK_THROWS_AS(precisionRecall(truth, {ScoredPair{9, 0, 1.0}}), std::out_of_range); }
+  }
+}
+
+SCENARIO(
+    "GIVEN a 4x4 loop-closure matrix WHEN neighbours within 1 frame are excluded THEN only far pairs are "
+    "evaluated") {
+  LoopClosureMatrix m;
+  m.size = 4;
+  m.same.assign(16, 0);
+  m.same[3 * 4 + 0] = 1;  // frame 3 revisits frame 0 (lower triangle only, like samples_GT.bmp)
+  m.same[0 * 4 + 3] = 1;
+  const LoopClosureTruth truth = truthFromMatrix(m, 1);
+  CHECK(truth.positives() == 1);
+  CHECK(truth.at(1, 0) == -1);
+  CHECK(truth.at(2, 0) == 0);
+  CHECK(truth.at(3, 1) == 0);
+  CHECK(truth.at(3, 2) == -1);
+}
+
+SCENARIO(
+    "GIVEN rooms with a doorway and a direct change WHEN boundaries are derived THEN the doorway gives an "
+    "interval") {
+  const auto b = roomBoundaries({0, 0, -1, -1, 1, 1, 1, 0, 0}, {0});
+  REQUIRE(b.size() == 2);
+  CHECK(b[0].from == 2);
+  CHECK(b[0].to == 4);
+  CHECK(b[1].from == 7);
+  CHECK(b[1].to == 7);
+  CHECK(roomBoundaries({0, -1, 0}, {0}).empty());                 // stepped into a doorway and back
+  CHECK(roomBoundaries({0, 0, 1, 1, 0, 0}, {0, 4}).size() == 1);  // no boundary at a traversal start
+
+  WHEN("cuts 3, 9, 20 are scored with tolerance 2") {
+    const BoundaryScore s = scoreBoundaries({3, 9, 20}, b, 2);
+    THEN("two match: precision 2/3, recall 1, F1 0.8") {
+      CHECK(s.matched == 2);
+      CHECK(s.precision == Approx(2.0 / 3.0));
+      CHECK(s.recall == Approx(1.0));
+      CHECK(s.f1 == Approx(0.8));
+      CHECK(s.mean_offset == Approx(1.0));  // 3 inside [2, 4]: 0; 9 after [7, 7]: +2
+    }
+  }
+  WHEN("the tolerance is 1") {
+    const BoundaryScore s = scoreBoundaries({3, 9, 20}, b, 1);
+    THEN("only the cut inside the doorway matches: F1 0.4") {
+      CHECK(s.matched == 1);
+      CHECK(s.f1 == Approx(0.4));
+    }
+  }
+  WHEN("two cuts fall in the same doorway") {
+    THEN("only one of them matches (one-to-one)") { CHECK(scoreBoundaries({3, 4}, b, 0).matched == 1); }
+  }
+}
+
+SCENARIO(
+    "GIVEN two traversals of rooms 0,1,0 WHEN places are counted THEN per traversal counts and consistency "
+    "follow") {
+  const std::vector<int> rooms = {0, 0, 1, 1, 0, 0, 1, 1, 0, 0};
+  const std::vector<std::int64_t> starts = {0, 5};
+  const auto counts = placesPerTraversal({1, 3, 6, 9}, rooms, starts);
+  REQUIRE(counts.size() == 2);
+  CHECK(counts[0].places == 2);
+  CHECK(counts[0].room_visits == 3);
+  CHECK(counts[1].places == 2);
+  CHECK(counts[1].room_visits == 3);
+  const ConsistencyScore all = crossTraversalConsistency({1, 3, 6, 9}, rooms, starts);
+  CHECK(all.eligible == 2);
+  CHECK(all.consistent == 2);
+  CHECK(all.rate == Approx(1.0));
+  WHEN("room 1 yields no place in the second traversal") {
+    const ConsistencyScore half = crossTraversalConsistency({1, 3, 9}, rooms, starts);
+    THEN("half the rooms are consistent") {
+      REQUIRE(half.rooms.size() == 2);
+      CHECK(half.rooms[1].places == std::vector<int>{1, 0});
+      CHECK(half.rate == Approx(0.5));
+    }
+  }
+  CHECK(traversalOf(4, starts) == 0);
+  CHECK(traversalOf(5, starts) == 1);
+}
+
+SCENARIO(
+    "GIVEN six places on four nodes over three rooms WHEN the topology is scored THEN merges, splits and "
+    "closures are counted") {
+  // nodes 0,1,2,0,1,3; rooms 0,1,2,0,2,1: place 3 closes correctly on node 0, place 4 closes wrongly on
+  // node 1 (room 2, node 1 so far only room 1), place 5 opens node 3 in room 1 seen before: missed.
+  const TopologyScore s = scoreTopology({0, 1, 2, 0, 1, 3}, {0, 1, 2, 0, 2, 1});
+  CHECK(s.nodes == 4);
+  CHECK(s.rooms == 3);
+  CHECK(s.one_to_one == 1);    // node 0 <-> room 0
+  CHECK(s.merged_nodes == 1);  // node 1 spans rooms 1 and 2
+  CHECK(s.split_rooms == 2);   // room 1 on nodes 1 and 3; room 2 on nodes 2 and 1
+  CHECK(s.loop_closures == 2);
+  CHECK(s.wrong_loop_closures == 1);
+  CHECK(s.missed_loop_closures == 1);
+  CHECK_THROWS_AS(scoreTopology({0}, {}), std::invalid_argument);
+}
+
+SCENARIO(
+    "GIVEN values with ties WHEN the majority is taken THEN the smallest most frequent value >= 0 wins") {
+  CHECK(majority({2, 1, 2, 1, -1, -1, -1}) == 1);
+  CHECK(majority({-1}) == -1);
+  CHECK(majority({3, 3, 1}) == 3);
+}

@@ -1,0 +1,255 @@
+// Pipeline with fake stages: order and completeness, the filter step spread over frames within the
+// per-frame budget, counted drops (not growth) behind a slow stage, clean stop (step finished, map saved
+// once while idle), stage failures, bad frames, status.
+#include <catch2/catch.hpp>
+
+#include <future>
+#include <set>
+
+#include "pipeline_fakes.hpp"
+#include "toposlam/pipeline/pipeline.hpp"
+
+using namespace toposlam;
+using namespace toposlam::test;
+
+namespace {
+
+PipelineConfig losslessConfig() {
+  PipelineConfig c;
+  c.queues.overflow = QueueOverflow::Block;
+  c.filter_budget_ms = 2.0;
+  c.map_path = "/tmp/unused-by-fake.tsm";
+  c.map_save_period_s = 0.0;  // only at stop
+  c.status_period_s = 60.0;
+  c.heartbeat_timeout_s = 600.0;
+  return c;
+}
+
+}  // namespace
+
+SCENARIO("The filter step of a place is spread over the following frames within the per-frame budget") {
+  GIVEN("100 frames, a place closing every 10 frames, a step of 5 slices of 1 ms and a budget of 2 ms per frame") {
+    ManualClock clock;
+    FakeSource source(100);
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(10);
+    FakeTopology topology(clock, 5, 1e-3);
+    RecordingSink sink;
+    {
+      Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+      pipeline.start();
+      pipeline.wait();
+      REQUIRE(pipeline.error().empty());
+      REQUIRE(pipeline.finished());
+    }
+    THEN("every frame is published once, in order") {
+      std::vector<std::int64_t> sequences;
+      for (const FrameResult& r : sink.results)
+        if (r.has_frame) sequences.push_back(r.sequence);
+      REQUIRE(sequences.size() == 100);
+      for (std::size_t i = 0; i < sequences.size(); ++i) CHECK(sequences[i] == static_cast<std::int64_t>(i));
+    }
+    THEN("place p (closed at frame 10p+9) finishes at frame 10p+11: 2 + 2 + 1 slices") {
+      std::vector<std::pair<std::int64_t, int>> finished;  // (frame or -1 for the flush record, place)
+      for (const FrameResult& r : sink.results)
+        for (const auto& [place, assignment] : r.finished_places)
+          finished.emplace_back(r.has_frame ? r.sequence : -1, assignment.place);
+      REQUIRE(finished.size() == 10);
+      for (int p = 0; p < 9; ++p) {
+        CHECK(finished[static_cast<std::size_t>(p)].first == 10 * p + 11);
+        CHECK(finished[static_cast<std::size_t>(p)].second == p);
+      }
+      CHECK(finished[9] == std::make_pair(std::int64_t{-1}, 9));  // the stream ended first: flush record
+      // No frame spent more than the budget plus one slice in the filter.
+      for (const FrameResult& r : sink.results)
+        if (r.has_frame) CHECK(r.filter_ms <= 2.0 + 1e-6);
+    }
+    THEN("the estimate of frame 11 is place 0 on node 0, and frame 41 sees the loop close (place 3 -> node 0)") {
+      CHECK(sink.results[11].estimate.place == 0);
+      CHECK(sink.results[10].estimate.place == -1);
+      CHECK(sink.results[41].estimate.place == 3);
+      CHECK(sink.results[41].estimate.node == 0);
+      CHECK_FALSE(sink.results[41].estimate.is_new);
+    }
+    THEN("the map is saved once, at the end, with no step in progress; every frame buffer went back") {
+      REQUIRE(topology.saves.size() == 1);
+      CHECK(topology.saved_while_idle[0]);
+      CHECK(topology.saved_at_revision[0] == 10);
+      CHECK(source.released.load() == 100);
+    }
+    THEN("the final status counts everything") {
+      REQUIRE_FALSE(sink.statuses.empty());
+      const PipelineStatus& s = sink.statuses.back();
+      CHECK(s.state == "finished");
+      CHECK(s.frames_captured == 100);
+      CHECK(s.frames_published == 100);
+      CHECK(s.frames_dropped == 0);
+      CHECK(s.places == 10);
+      CHECK(s.maps_saved == 1);
+      REQUIRE(s.stages.size() == 5);
+      CHECK(s.stages[1].name == "fingerprint");
+      CHECK(s.stages[1].processed == 100);
+      CHECK(s.stages[3].processed == 100);
+    }
+  }
+}
+
+SCENARIO("A slow stage causes counted drops of the oldest frames, not growth") {
+  GIVEN("200 frames, a frame queue of capacity 2, drop-oldest, and a fingerprint stage stuck on frame 0") {
+    ManualClock clock;
+    FakeSource source(200);
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(1000);
+    FakeTopology topology(clock, 1, 1e-3);
+    RecordingSink sink;
+    std::promise<void> fingerprint_started, source_ended;
+    std::shared_future<void> started = fingerprint_started.get_future().share();
+    std::shared_future<void> ended = source_ended.get_future().share();
+    // Frame 1 and later only come once frame 0 is in the fingerprint stage, which holds on to it until
+    // the source has delivered everything: the capture thread outruns it by 199 frames.
+    source.before_frame = [&](std::int64_t i) {
+      if (i >= 1) started.wait();
+    };
+    source.on_end = [&, done = false]() mutable {
+      if (!done) source_ended.set_value();
+      done = true;
+    };
+    fingerprint.on_process = [&, first = true](int) mutable {
+      if (!first) return;
+      first = false;
+      fingerprint_started.set_value();
+      ended.wait();
+    };
+    PipelineConfig config = losslessConfig();
+    config.queues.overflow = QueueOverflow::DropOldest;
+    config.queues.frames = 2;
+    Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+    pipeline.start();
+    pipeline.wait();
+    THEN("197 frames were dropped from the fingerprint stage's input and the newest two survived") {
+      std::vector<std::int64_t> sequences;
+      for (const FrameResult& r : sink.results)
+        if (r.has_frame) sequences.push_back(r.sequence);
+      CHECK(sequences == std::vector<std::int64_t>{0, 198, 199});
+      REQUIRE_FALSE(sink.statuses.empty());
+      const PipelineStatus& s = sink.statuses.back();
+      CHECK(s.stages[1].dropped == 197);
+      CHECK(s.frames_dropped == 197);
+      CHECK(s.stages[1].queue_capacity == 2);
+      CHECK(s.frames_captured == 200);
+      CHECK(source.released.load() == 200);  // dropped frames handed their buffers back too
+    }
+  }
+}
+
+SCENARIO("requestStop() finishes the filter steps in progress and saves the map once") {
+  GIVEN("an endless source, a place every 10 frames and steps of 50 slices (25 frames each)") {
+    ManualClock clock;
+    FakeSource source(-1);
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(10);
+    FakeTopology topology(clock, 50, 1e-3);
+    RecordingSink sink;
+    Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+    pipeline.start();
+    WHEN("stop is requested after 40 frames were published") {
+      sink.waitForFrames(40);
+      pipeline.requestStop();
+      pipeline.wait();
+      THEN("every closed place got its step finished, the map was saved once while idle, no error") {
+        int finished = 0;
+        for (const FrameResult& r : sink.results) finished += static_cast<int>(r.finished_places.size());
+        CHECK(segmentation.closed >= 4);
+        CHECK(finished == segmentation.closed);
+        REQUIRE(topology.saves.size() == 1);
+        CHECK(topology.saved_while_idle[0]);
+        CHECK(topology.saved_at_revision[0] == segmentation.closed);
+        CHECK(pipeline.error().empty());
+        CHECK(pipeline.finished());
+      }
+    }
+  }
+}
+
+SCENARIO("A failing stage ends the pipeline with an error instead of hanging") {
+  GIVEN("an endless source and a segmentation that throws at frame 20") {
+    ManualClock clock;
+    FakeSource source(-1);
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(10);
+    segmentation.throw_at = 20;
+    FakeTopology topology(clock, 1, 1e-3);
+    RecordingSink sink;
+    Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+    pipeline.start();
+    pipeline.wait();
+    THEN("every thread ended and the error names the stage") {
+      CHECK(pipeline.finished());
+      CHECK_THAT(pipeline.error(), Catch::Contains("segmentation: boom"));
+      CHECK(sink.frames == 20);
+    }
+  }
+}
+
+SCENARIO("Bad frames are skipped and counted, the stream goes on") {
+  GIVEN("50 frames of which those with sequence % 10 == 3 cannot be fingerprinted") {
+    ManualClock clock;
+    FakeSource source(50);
+    FakeFingerprint fingerprint;
+    fingerprint.throw_when = [](int value) { return value % 10 == 3; };
+    FakeSegmentation segmentation(1000);
+    FakeTopology topology(clock, 1, 1e-3);
+    RecordingSink sink;
+    Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+    pipeline.start();
+    pipeline.wait();
+    THEN("45 frames are published and none of the bad ones") {
+      CHECK(sink.frames == 45);
+      for (const FrameResult& r : sink.results) CHECK(r.sequence % 10 != 3);
+      CHECK(pipeline.error().empty());
+      CHECK(source.released.load() == 50);
+    }
+  }
+}
+
+SCENARIO("The pipeline config is validated with the key and the allowed range") {
+  PipelineConfig c;
+  CHECK(c.validate().empty());
+  c.queues.frames = 0;
+  CHECK_THAT(c.validate(), Catch::StartsWith("queues.frames: ") && Catch::Contains("1 .. 1024"));
+  c = PipelineConfig{};
+  c.filter_budget_ms = 0.0;
+  CHECK_THAT(c.validate(), Catch::StartsWith("filter_budget_ms: ") && Catch::Contains("0.1 .. 1000"));
+  c = PipelineConfig{};
+  c.map_save_period_s = 0.5;
+  CHECK_THAT(c.validate(), Catch::StartsWith("map_save_period_s: ") && Catch::Contains("0 (only at stop) or 1 .. 86400"));
+  c = PipelineConfig{};
+  c.threads.topology.nice = 40;
+  CHECK_THAT(c.validate(), Catch::StartsWith("threads.topology.nice: "));
+  ManualClock clock;
+  FakeSource source(1);
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  CHECK_THROWS_WITH(Pipeline(c, source, fingerprint, segmentation, topology, sink, clock),
+                    Catch::StartsWith("pipeline.threads.topology.nice"));
+}
+
+SCENARIO("Latency summaries: median, nearest-rank p99 and max") {
+  std::vector<double> values;
+  for (int i = 100; i >= 1; --i) values.push_back(i);
+  LatencyStats s = summarizeLatencies(values);
+  CHECK(s.samples == 100);
+  CHECK(s.median_ms == Approx(50.5));
+  CHECK(s.p99_ms == Approx(99.0));
+  CHECK(s.max_ms == Approx(100.0));
+  std::vector<double> one{7.0};
+  s = summarizeLatencies(one);
+  CHECK(s.median_ms == 7.0);
+  CHECK(s.p99_ms == 7.0);
+  std::vector<double> none;
+  s = summarizeLatencies(none);
+  CHECK(s.samples == 0);
+  CHECK(s.max_ms == 0.0);
+}

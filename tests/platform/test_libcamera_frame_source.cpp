@@ -1,0 +1,72 @@
+// LibcameraFrameSource where no camera hardware exists: the camera manager starts, unknown IDs and
+// "no cameras at all" give clear errors, URIs parse. Frame capture itself needs a real camera.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+
+#include "toposlam/io/libcamera_frame_source.hpp"
+#include "toposlam/io/source_factory.hpp"
+
+using toposlam::FrameSourceError;
+using toposlam::LibcameraFrameSource;
+
+SCENARIO("GIVEN libcamera WHEN the camera manager starts THEN it lists cameras (possibly none)") {
+  std::vector<std::string> cameras;
+  REQUIRE_NOTHROW(cameras = toposlam::listLibcameraCameras());
+  CHECK(std::none_of(cameras.begin(), cameras.end(), [](const std::string& id) { return id.empty(); }));
+  CHECK(toposlam::libcameraVersion().find('.') != std::string::npos);
+  AND_WHEN("the manager is started twice in a row THEN the second start works too (shared manager)") {
+    CHECK(toposlam::listLibcameraCameras() == cameras);
+  }
+}
+
+SCENARIO("GIVEN an unknown camera ID WHEN opening THEN the error names it and lists what exists") {
+  toposlam::LibcameraSourceConfig config;
+  config.camera_id = "/base/no/such/camera@99";
+  const auto cameras = toposlam::listLibcameraCameras();
+  REQUIRE_THROWS_AS(LibcameraFrameSource(config), FrameSourceError);
+  try {
+    LibcameraFrameSource source(config);
+  } catch (const FrameSourceError& error) {
+    const std::string message = error.what();
+    CHECK(message.find("libcamera:/base/no/such/camera@99: no camera with this ID") != std::string::npos);
+    if (cameras.empty())
+      CHECK(message.find("found no cameras") != std::string::npos);
+    else
+      CHECK(message.find("available: " + cameras.front()) != std::string::npos);
+  }
+}
+
+SCENARIO("GIVEN no cameras WHEN opening the first camera THEN the error says none were found") {
+  if (!toposlam::listLibcameraCameras().empty()) {
+    WARN("this machine has a libcamera camera; the no-camera path is not exercised");
+    return;
+  }
+  toposlam::LibcameraSourceConfig config;
+  REQUIRE_THROWS_WITH(LibcameraFrameSource(config), Catch::Contains("libcamera found no cameras"));
+}
+
+SCENARIO(
+    "GIVEN the libcamera scheme registered WHEN an unknown camera is opened by URI THEN the factory reports "
+    "it") {
+  toposlam::registerLibcameraFrameSourceScheme();
+  CHECK_THROWS_WITH(toposlam::openFrameSource("libcamera:/no/such/camera?size=320x240"),
+                    Catch::Contains("no camera with this ID"));
+}
+
+SCENARIO("GIVEN libcamera URIs WHEN parsed THEN the ID and parameters are read and bad ones named") {
+  const auto config =
+      toposlam::parseLibcameraUri("libcamera:/base/soc/i2c0mux/i2c@1/imx219@10?size=320x240&buffers=6");
+  CHECK(config.camera_id == "/base/soc/i2c0mux/i2c@1/imx219@10");
+  CHECK(config.width == 320);
+  CHECK(config.height == 240);
+  CHECK(config.buffer_count == 6);
+  CHECK(toposlam::parseLibcameraUri("libcamera:").camera_id.empty());
+  CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?size=big"),
+                    Catch::Contains("size: expected WxH"));
+  CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?buffers=64"),
+                    Catch::Contains("buffers: must be in [2, 16]"));
+  CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?fps=30"),
+                    Catch::Contains("unknown parameter 'fps'"));
+  CHECK_THROWS_AS(toposlam::parseLibcameraUri("v4l2:/dev/video0"), FrameSourceError);
+}

@@ -1,0 +1,86 @@
+// OfflineSegmentation's bookkeeping and the run-folder writers (docs/run-folder.md), with fake
+// fingerprints and a table similarity: frame rows get their place once it closes, dropped places are
+// -1, CSV headers and columns are exact, the lambda2 plot marks each valley-closed border.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fake_similarity.hpp"
+#include "toposlam/segmentation/offline_segmentation.hpp"
+
+using toposlam::test::fakeFingerprint;
+using toposlam::test::TableSimilarity;
+
+namespace {
+
+std::vector<std::string> linesOf(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineSegmentation THEN the rows and "
+    "CSV files follow docs/run-folder.md",
+    "[segmentation][run]") {
+  auto block = [](int f) { return f < 40 ? 0 : (f < 80 ? 1 : 2); };
+  TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
+  const toposlam::VpackExtractor extractor;  // unused: fingerprints are given
+  toposlam::OfflineSegmentation pipeline(extractor, similarity, {});
+  for (int f = 0; f < 120; ++f) {
+    std::string name = "f";
+    name.append(std::to_string(f)).append(".png");
+    pipeline.segment(0.5 * f, name, fakeFingerprint(f, block(f) == 1 ? 3 : 40));
+  }
+  THEN("before finish, the last block's frames have no place yet") {
+    CHECK(pipeline.run().frames[100].place == -1);
+    CHECK(pipeline.run().frames[10].place == 0);
+  }
+  REQUIRE(pipeline.finish().has_value());
+  const toposlam::SegmentationRun& run = pipeline.run();
+  REQUIRE(run.places.size() == 2);
+  REQUIRE(run.dropped_places.size() == 1);
+  CHECK(run.frames[10].place == 0);
+  CHECK(run.frames[50].place == -1);
+  CHECK(run.frames[50].in_dropped_place);
+  CHECK(run.frames[100].place == 1);
+
+  std::ostringstream frames_csv, places_csv, dropped_csv;
+  toposlam::writeFramesCsv(frames_csv, run, {7, 9});
+  toposlam::writePlacesCsv(places_csv, run.places, {7, 9});
+  toposlam::writePlacesCsv(dropped_csv, run.dropped_places);
+  const auto frames = linesOf(frames_csv.str());
+  REQUIRE(frames.size() == 121);
+  CHECK(frames[0] == "frame,time,name,lambda2,place,node");
+  CHECK(frames[1] == "0,0.000000,f0.png,,0,7");  // one frame in the window: no lambda2 yet
+  CHECK(frames[2] == "1,0.500000,f1.png,2.000000,0,7");
+  CHECK(frames[71] == "70,35.000000,f70.png,1.041667,-1,-1");  // a full window inside block 1
+  CHECK(frames[101].substr(frames[101].size() - 4) == ",1,9");
+  const auto places = linesOf(places_csv.str());
+  REQUIRE(places.size() == 3);
+  CHECK(places[0] == "place,first,last,representative,keypoints,node");
+  CHECK(places[1].rfind("0,0,39,", 0) == 0);
+  CHECK(places[2].rfind("1,80,119,", 0) == 0);
+  CHECK(places[2].substr(places[2].size() - 5) == ",40,9");
+  const auto dropped = linesOf(dropped_csv.str());
+  REQUIRE(dropped.size() == 2);
+  CHECK(dropped[1].rfind("0,40,79,", 0) == 0);
+  CHECK(dropped[1].substr(dropped[1].size() - 5) == ",3,-1");
+
+  THEN("the lambda2 plot has one series and a dashed line at each of the two valley-closed borders") {
+    const toposlam::SvgPlot plot = toposlam::lambda2Plot(run, {}, "test");
+    REQUIRE(plot.series.size() == 1);
+    CHECK(plot.series[0].y.size() == 120);
+    CHECK(std::isnan(plot.series[0].y[0]));
+    REQUIRE(plot.vertical_lines.size() == 2);
+    CHECK(plot.vertical_lines[0].value == 39.5);
+    CHECK(plot.vertical_lines[1].value == 79.5);
+    CHECK(plot.horizontal_lines.at(0).value == 0.5);
+  }
+}

@@ -1,0 +1,110 @@
+// Tests of floor plans: YAML parsing and its error messages, the built-in worlds, the decoration.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "toposlam/sim/floor_plan.hpp"
+#include "toposlam/sim/simulator.hpp"
+
+using namespace toposlam::sim;
+
+namespace {
+
+const char* const kTwoRooms = R"(
+name: flat
+rooms:
+  - name: left
+    rect: [0, 0, 4, 3]
+    wall: [200, 100, 50]
+    posters: 2
+  - name: right
+    polygon: [[4, 0], [8, 0], [8, 3], [4, 3]]
+    floor_pattern: tiles
+doors:
+  - {at: [4, 1.5], width: 1.0}
+loop:
+  - [2, 1.5]
+  - {at: [6, 1.5], pause: 1.0}
+  - [6, 2.2]
+)";
+
+std::string errorOf(const std::string& yaml) {
+  try {
+    parseFloorPlan(yaml, "test.yaml");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a YAML floor plan WHEN it is parsed THEN rooms, doors and the loop are as written", "[sim]") {
+  World world = parseFloorPlan(kTwoRooms, "test.yaml");
+  REQUIRE(world.rooms.size() == 2);
+  CHECK(world.name == "flat");
+  CHECK(world.rooms[0].wall_bgr == cv::Vec3b(50, 100, 200));  // YAML is RGB, stored BGR
+  CHECK(world.rooms[1].floor_pattern == FloorPattern::Tiles);
+  REQUIRE(world.doors.size() == 1);
+  CHECK(world.doors[0].room_a + world.doors[0].room_b == 1);
+  REQUIRE(world.loop.size() == 3);
+  CHECK(world.loop[1].pause_s == 1.0);
+  CHECK(world.roomContaining({1, 1}) == 0);
+  CHECK(world.roomContaining({7, 1}) == 1);
+  CHECK(world.placeLabel({4.1, 1.5}) == -1);  // in the doorway
+  CHECK(world.placeLabel({4.5, 1.5}) == 1);
+
+  // It renders through the same path as the built-in worlds, from a file.
+  const auto path = std::filesystem::temp_directory_path() / "toposlam_test_flat.yaml";
+  std::ofstream(path) << kTwoRooms;
+  SimConfig config;
+  config.world = path.string();
+  config.fps = 2;
+  config.camera.width = 96;
+  config.camera.height = 72;
+  const Simulator simulator(config);
+  CHECK(simulator.frameCount() > 5);
+  CHECK(simulator.render(0).image.size() == cv::Size(96, 72));
+  std::filesystem::remove(path);
+}
+
+TEST_CASE("GIVEN malformed floor plans WHEN parsed THEN the message names the offending key", "[sim]") {
+  CHECK_THAT(errorOf("rooms: []"), Catch::Contains("rooms"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4]\n"), Catch::Contains("rooms[0].rect"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\n    wall: [300, 0, 0]\n"), Catch::Contains("rooms[0].wall"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\n    floor_pattern: marble\n"), Catch::Contains("carpet"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\ndoors:\n  - {at: [9, 9]}\n"), Catch::Contains("doors[0].at"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\nloop: [[1, 1], [9, 9]]\n"), Catch::Contains("loop[1]"));
+  CHECK_THAT(errorOf("rooms: [ {rect: [0, 0"), Catch::Contains("test.yaml"));
+  CHECK_THROWS_WITH(loadFloorPlanFile("/nonexistent/plan.yaml"), Catch::Contains("/nonexistent/plan.yaml"));
+}
+
+TEST_CASE("GIVEN the built-in worlds WHEN decorated THEN every room is furnished and nothing blocks the loop", "[sim]") {
+  for (const std::string& name : builtinWorldNames()) {
+    World world = loadWorld(name);
+    CHECK(world.validate().empty());
+    decorate(world, 1);
+    for (const Room& room : world.rooms) {
+      int decor = 0, furniture = 0;
+      int signs = 0;
+      for (const WallDecor& item : world.decor) {
+        if (item.room != room.id) continue;
+        (item.kind == DecorKind::Sign ? signs : decor) += 1;
+      }
+      CHECK(signs >= 5);  // small notices along every room's walls (about one per 1.5 m where free)
+      for (const Furniture& item : world.furniture) furniture += item.room == room.id ? 1 : 0;
+      INFO(name << " room " << room.name);
+      CHECK(decor == room.posters + room.boards);
+      CHECK(furniture == room.shelves + room.desks);
+    }
+    // The same seed decorates identically; another seed differently.
+    World again = loadWorld(name);
+    decorate(again, 1);
+    REQUIRE(again.decor.size() == world.decor.size());
+    CHECK(again.decor[0].u0 == world.decor[0].u0);
+    World other = loadWorld(name);
+    decorate(other, 2);
+    CHECK(other.decor[0].u0 != world.decor[0].u0);
+  }
+}

@@ -1,0 +1,315 @@
+// Tests of TopologyParticleFilter (thesis chapter 5): the model's numbers, loop closing over two
+// traversals, look-alike places, Bell-number completeness, determinism, slicing, sharing.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "fake_similarity.hpp"
+#include "toposlam/topology/map_store.hpp"
+#include "toposlam/topology/topology_particle_filter.hpp"
+
+using namespace toposlam;
+using toposlam::test::placeSimilarity;
+using toposlam::test::taggedFingerprint;
+using toposlam::test::TagSimilarity;
+
+namespace {
+
+TopologyFilterConfig configWith(int particles, std::uint64_t seed) {
+  TopologyFilterConfig c;
+  c.particles = particles;
+  c.seed = seed;
+  return c;
+}
+
+void run(TopologyParticleFilter& filter, const std::vector<int>& places) {
+  for (int p : places) filter.step(taggedFingerprint(p));
+}
+
+std::string stateBytes(const TopologyParticleFilter& filter) {
+  std::ostringstream out;
+  filter.saveState(out);
+  return out.str();
+}
+
+std::vector<int> route(int places, int traversals) {
+  std::vector<int> r;
+  for (int t = 0; t < traversals; ++t) {
+    for (int p = 0; p < places; ++p) r.push_back(p);
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "GIVEN the thesis' gamma(k = 10, theta = 0.25) WHEN evaluated at x = j + 1 THEN Figure 5.3's weights",
+    "[topology]") {
+  const std::array<double, 5> expected{0.053, 0.496, 0.350, 0.085, 0.012};
+  for (int j = 0; j < 5; ++j)
+    CHECK(gammaPdf(j + 1.0, 10.0, 0.25) == Approx(expected[static_cast<std::size_t>(j)]).margin(0.0006));
+
+  const KnownNodeTransition t = knownNodeTransition(TopologyFilterConfig{});
+  double gamma_total = t.stay;
+  for (double w : t.successor) gamma_total += w;
+  CHECK(gamma_total == Approx(0.95).epsilon(1e-12));
+  CHECK(t.new_node == 0.05);
+  REQUIRE(t.successor.size() == 5);
+  CHECK(t.stay == Approx(0.95 * 0.0529 / 0.9977).margin(0.001));
+  CHECK(t.successor[0] == Approx(0.4727).margin(0.001));  // 0.496 * 0.95 / 0.9977
+}
+
+TEST_CASE(
+    "GIVEN Figure 5.2's known-node likelihoods WHEN the new-node likelihood is computed THEN (1 - 0.4) * "
+    "0.85",
+    "[topology]") {
+  const std::vector<double> likelihoods{0.1, 0.05, 0.4, 0.2, 0.1};
+  CHECK(normalisedEntropy(likelihoods) == Approx(0.848).margin(0.001));
+  CHECK(newNodeLikelihood(likelihoods) == Approx(0.509).margin(0.001));  // thesis rounds to 0.51
+  const std::vector<double> single{0.7};
+  CHECK(normalisedEntropy(single) == 1.0);  // eta = 1 with one known node
+  CHECK(newNodeLikelihood(single) == Approx(0.3));
+  const std::vector<double> uniform{0.3, 0.3, 0.3};
+  CHECK(normalisedEntropy(uniform) == Approx(1.0));
+  const std::vector<double> peaked{0.9, 0.0, 0.0};
+  CHECK(normalisedEntropy(peaked) == Approx(0.0).margin(1e-12));
+}
+
+TEST_CASE("GIVEN bad configs WHEN validated THEN the key and its range are named", "[topology]") {
+  TopologyFilterConfig c;
+  CHECK(c.validate().empty());
+  c.particles = 0;
+  CHECK(c.validate().rfind("particles:", 0) == 0);
+  c = {};
+  c.alpha = -1;
+  CHECK(c.validate().rfind("alpha:", 0) == 0);
+  c = {};
+  c.max_successors = 9;
+  CHECK(c.validate().rfind("max_successors:", 0) == 0);
+  c = {};
+  c.max_representatives_per_node = 0;
+  CHECK(c.validate().rfind("max_representatives_per_node:", 0) == 0);
+  auto sim = placeSimilarity();
+  CHECK_THROWS_AS(TopologyParticleFilter(c, sim), std::invalid_argument);
+}
+
+TEST_CASE(
+    "GIVEN a flat similarity WHEN two observations are filtered THEN eq. 5.8 proposes staying with 1 / (1 + "
+    "alpha)",
+    "[topology]") {
+  auto sim = TagSimilarity([](int, int) { return 0.5; });
+  TopologyParticleFilter filter(configWith(20000, 3), sim);
+  run(filter, {0, 1});
+  int stayed = 0;
+  for (int i = 0; i < 20000; ++i) stayed += filter.particleAssignment(i) == std::vector<int>{0, 0} ? 1 : 0;
+  CHECK(stayed / 20000.0 == Approx(1.0 / 16.0).margin(0.006));
+  CHECK(filter.lastEffectiveSampleSize() == Approx(20000.0).epsilon(1e-9));  // equal weights
+}
+
+TEST_CASE(
+    "GIVEN a flat similarity and many particles WHEN 4 observations are filtered THEN all B_4 = 15 "
+    "topologies appear",
+    "[topology][bell]") {
+  auto sim = TagSimilarity([](int, int) { return 0.5; });
+  for (bool forbid : {false, true}) {
+    std::set<std::vector<int>> seen;
+    int abab = 0, aba = 0;
+    for (std::uint64_t seed : {1u, 2u, 3u}) {
+      TopologyFilterConfig c = configWith(20000, seed);
+      c.forbid_return_to_previous = forbid;
+      TopologyParticleFilter filter(c, sim);
+      run(filter, {0, 1, 2, 3});
+      for (int i = 0; i < c.particles; ++i) {
+        const std::vector<int> a = filter.particleAssignment(i);
+        // A topology is a restricted growth string: each node is at most one more than the largest before.
+        int largest = -1;
+        for (int n : a) {
+          REQUIRE(n <= largest + 1);
+          largest = std::max(largest, n);
+        }
+        seen.insert(a);
+        if (a[0] == 0 && a[1] == 1 && a[2] == 0) {
+          ++aba;
+          abab += a[3] == 1 ? 1 : 0;
+        }
+      }
+    }
+    if (!forbid) {
+      CHECK(seen.size() == 15);  // Bell number B_4
+      // From A with successor list [B]: the 1st successor gets 0.496 * 0.95 / 0.9977.
+      CHECK(static_cast<double>(abab) / aba == Approx(0.4727).margin(0.03));
+    } else {
+      CHECK(seen.size() == 14);  // A B A B needs the move back to the previous node
+      CHECK(abab == 0);
+    }
+  }
+}
+
+TEST_CASE(
+    "GIVEN two traversals of a synthetic route WHEN filtered THEN the second closes the loop onto the same "
+    "nodes",
+    "[topology]") {
+  auto sim = placeSimilarity(0.9, 0.1);
+  const std::vector<int> places = route(8, 2);
+  for (std::uint64_t seed : {1u, 7u, 42u}) {
+    TopologyParticleFilter filter(configWith(500, seed), sim);
+    run(filter, places);
+    const TopologyEstimate e = filter.estimate();
+    CHECK(e.best.assignment == places);  // nodes 0..7, then 0..7 again
+    CHECK(e.best.node_count == 8);
+    CHECK(e.best.probability > 0.5);
+    CHECK(e.current_node == 7);
+    CHECK(e.current_node_probability >= e.best.probability);
+    CHECK(e.effective_sample_size > 0.0);
+    CHECK(e.effective_sample_size <= 500.0);
+    REQUIRE_FALSE(e.locations.empty());
+    CHECK(e.locations[0].founding_observation == 7);
+    CHECK(e.locations[0].node_in_best == 7);
+  }
+}
+
+TEST_CASE(
+    "GIVEN a route through look-alike places WHEN filtered THEN several hypotheses live until the path tells "
+    "them apart",
+    "[topology]") {
+  // Places 2 and 5 look the same. First traversal 0..7, then the second traversal.
+  auto looks = [](int p) { return p == 5 ? 2 : p; };
+  auto sim = TagSimilarity([&](int a, int b) { return looks(a) == looks(b) ? 0.9 : 0.1; });
+  int kept_both = 0, recovered = 0;
+  const std::vector<std::uint64_t> seeds{1, 2, 3, 4, 5};
+  for (std::uint64_t seed : seeds) {
+    TopologyParticleFilter filter(configWith(500, seed), sim);
+    run(filter, {0, 1, 2, 3, 4, 5});
+    // Observation 5 is either the first visit of place 5 or a return to node 2.
+    const TopologyEstimate ambiguous = filter.estimate();
+    double first_visit = 0.0, return_to_2 = 0.0;
+    for (const auto& l : ambiguous.locations) {
+      if (l.founding_observation == 5) first_visit = l.probability;
+      if (l.founding_observation == 2) return_to_2 = l.probability;
+    }
+    INFO("seed " << seed << ": new " << first_visit << ", node 2 " << return_to_2);
+    kept_both += first_visit >= 0.2 && return_to_2 >= 0.2 ? 1 : 0;
+    // Place 6 is new: a return to node 2 predicted node 3 next, so that hypothesis fades.
+    filter.step(taggedFingerprint(6));
+    const TopologyEstimate told = filter.estimate();
+    CHECK(told.best.assignment == std::vector<int>{0, 1, 2, 3, 4, 5, 6});
+    CHECK(told.best.probability > 0.5);
+    // The second traversal.
+    run(filter, {7, 0, 1, 2, 3, 4, 5, 6, 7});
+    const TopologyEstimate e = filter.estimate();
+    const std::vector<int> truth{0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7};
+    recovered += e.best.assignment == truth && e.best.probability > 0.3 ? 1 : 0;
+  }
+  CHECK(kept_both == static_cast<int>(seeds.size()));
+  CHECK(recovered == static_cast<int>(seeds.size()));
+}
+
+TEST_CASE("GIVEN the same input and seed WHEN run twice THEN the states are identical bit for bit",
+          "[topology]") {
+  auto sim = placeSimilarity(0.8, 0.2);
+  const std::vector<int> places = route(6, 3);
+  TopologyParticleFilter a(configWith(300, 11), sim), b(configWith(300, 11), sim),
+      c(configWith(300, 12), sim);
+  run(a, places);
+  run(b, places);
+  run(c, places);
+  CHECK(stateBytes(a) == stateBytes(b));
+  CHECK(stateBytes(a) != stateBytes(c));
+}
+
+TEST_CASE("GIVEN a step run in slices WHEN compared with whole steps THEN every state is identical",
+          "[topology][slice]") {
+  auto sim = placeSimilarity(0.8, 0.15);
+  const std::vector<int> places = route(7, 3);
+  TopologyParticleFilter whole(configWith(200, 5), sim), sliced(configWith(200, 5), sim);
+  int max_slices = 0;
+  for (std::size_t k = 0; k < places.size(); ++k) {
+    whole.step(taggedFingerprint(places[k]));
+    sliced.beginStep(taggedFingerprint(places[k]));
+    CHECK(sliced.stepInProgress());
+    CHECK_THROWS_AS(sliced.beginStep(taggedFingerprint(0)), std::logic_error);
+    std::ostringstream sink;
+    CHECK_THROWS_AS(sliced.saveState(sink), std::logic_error);
+    int slices = 1;
+    while (!sliced.advance(7 + k % 5)) ++slices;
+    max_slices = std::max(max_slices, slices);
+    REQUIRE(stateBytes(whole) == stateBytes(sliced));
+    CHECK(whole.lastEffectiveSampleSize() == sliced.lastEffectiveSampleSize());
+  }
+  CHECK(max_slices >= 3 * 200 / 11);  // propose + update alone are 400 items
+  CHECK(sliced.advance(1));           // no step in progress
+  CHECK_THROWS_AS(sliced.advance(0), std::invalid_argument);
+}
+
+TEST_CASE(
+    "GIVEN 500 particles WHEN a step runs THEN each stored representative is compared once, not once per "
+    "particle",
+    "[topology]") {
+  auto sim = placeSimilarity(0.9, 0.1);
+  TopologyParticleFilter filter(configWith(500, 2), sim);
+  const std::vector<int> places = route(10, 2);
+  for (std::size_t k = 0; k < places.size(); ++k) {
+    const long before = sim.calls();
+    filter.step(taggedFingerprint(places[k]));
+    CHECK(sim.calls() - before <= static_cast<long>(k));  // at most one per earlier observation
+  }
+}
+
+TEST_CASE(
+    "GIVEN a cap of 2 representatives WHEN one place is seen 7 times THEN only the newest 2 are compared",
+    "[topology]") {
+  auto sim = TagSimilarity([](int, int) { return 1.0; });  // the same place: a new node has likelihood 0
+  TopologyFilterConfig c = configWith(500, 9);
+  c.max_representatives_per_node = 2;
+  TopologyParticleFilter filter(c, sim);
+  run(filter, {0, 0, 0, 0, 0, 0});
+  for (int i = 0; i < c.particles; ++i) REQUIRE(filter.particleAssignment(i) == std::vector<int>(6, 0));
+  const long before = sim.calls();
+  filter.step(taggedFingerprint(0));
+  CHECK(sim.calls() - before == 2);  // observations 4 and 5
+  for (int o = 0; o < 4; ++o) CHECK(filter.storedRepresentative(o) == nullptr);
+  CHECK(filter.storedRepresentative(4) != nullptr);
+  CHECK(filter.storedRepresentative(6) != nullptr);
+}
+
+TEST_CASE(
+    "GIVEN 500 particles and 300 observations WHEN the shared structures are counted THEN they do not grow "
+    "with particles x history",
+    "[topology][memory]") {
+  auto sim = placeSimilarity(0.7, 0.2);
+  TopologyParticleFilter filter(configWith(500, 4), sim);
+  run(filter, route(30, 10));
+  const TopologyMemoryStats stats = filter.memoryStats();
+  INFO("states " << stats.distinct_states << " records " << stats.history_records << " trie "
+                 << stats.trie_nodes);
+  CHECK(stats.distinct_states <= 500);
+  // Particles x history would be 150000 records: the lineages share their past.
+  CHECK(stats.history_records < 300 + 20 * 500);
+  CHECK(stats.trie_nodes < 20 * 500);
+  CHECK(stats.stored_fingerprints <= 300);
+}
+
+TEST_CASE(
+    "GIVEN a filter saved mid-run WHEN loaded and continued THEN it ends exactly like a run that never "
+    "stopped",
+    "[topology][persistence]") {
+  auto sim = placeSimilarity(0.85, 0.1);
+  const std::vector<int> places = route(9, 3);
+  TopologyParticleFilter straight(configWith(300, 21), sim);
+  run(straight, places);
+
+  TopologyParticleFilter first(configWith(300, 21), sim);
+  run(first, std::vector<int>(places.begin(), places.begin() + 13));
+  const std::string file = MapStore::encode(first, "app");
+  LoadedMap loaded = MapStore::decode(file, sim);
+  CHECK(loaded.application_data == "app");
+  CHECK(MapStore::encode(*loaded.filter, "app") == file);  // the reload is exact
+  run(*loaded.filter, std::vector<int>(places.begin() + 13, places.end()));
+  CHECK(stateBytes(*loaded.filter) == stateBytes(straight));
+  CHECK(loaded.filter->estimate().best.assignment == straight.estimate().best.assignment);
+}

@@ -1,0 +1,109 @@
+#!/bin/sh
+# Runs INSIDE the VM (chroot into the host's root, shared read-only over 9p; /tmp is a tmpfs) and
+# exercises the real, dynamically linked toposlam binaries against real V4L2 drivers:
+#   1. vivid (the kernel's test driver), BGR24: frames are handed out zero-copy (the lease re-queues
+#      the buffer); its "disconnect" control unplugs the camera mid-stream and the capture reconnects
+#      and carries on;
+#   2. v4l2loopback fed the bundled frames as YUYV by ffmpeg: `toposlam capture` receives frames with
+#      increasing sequence numbers and monotonic timestamps;
+#   3. toposlamd (when built) on the loopback device, publishing over LCM on lo, checked by a subscriber.
+# Prints "VMTEST PASS|FAIL|SKIP <what>" lines for tests/vm/run-vm-test.sh, then "VMTEST DONE failures=N".
+# Usage (from the initramfs init): guest.sh BUILD_DIR
+build=${1:?usage: guest.sh BUILD_DIR}
+toposlam=$build/src/apps/toposlam/toposlam
+toposlamd=${tsdaemon:-$build/src/apps/toposlamd/toposlamd}  # tsdaemon= on the kernel command line overrides
+export HOME=/tmp PATH=/usr/local/bin:/usr/bin:/bin:/usr/sbin:/sbin
+cd /tmp || exit 1
+failures=0
+uptime() { cut -d' ' -f1 /proc/uptime; }
+pass() { echo "VMTEST PASS [$(uptime) s] $*"; }
+fail() { echo "VMTEST FAIL [$(uptime) s] $*"; failures=$((failures + 1)); }
+step() { echo "VMTEST STEP [$(uptime) s] $*"; }
+show() { sed "s/^/  $1| /" "$2" | head -n "${3:-400}"; }
+
+# Waits until the loopback device has a writer with the given pixel format (fourcc), up to ~15 s.
+wait_for_writer() {
+  i=0
+  while [ $i -lt 60 ]; do
+    v4l2-ctl -d /dev/video0 --get-fmt-video 2>/dev/null | grep -q "'$1'" && return 0
+    sleep 0.25
+    i=$((i + 1))
+  done
+  return 1
+}
+
+# Checks a capture log: N frames, strictly increasing sequence and timestamps.
+check_capture_log() {  # log expected_frames what
+  if ! grep -q "^summary frames=$2 " "$1"; then fail "$3: expected $2 frames"; return 1; fi
+  if ! awk '/^frame /{ split($2,s,"="); split($3,t,"=");
+              if (n++ && (s[2]+0 <= seq || t[2]+0 <= ts)) bad++; seq=s[2]+0; ts=t[2]+0 }
+            END { exit bad ? 1 : 0 }' "$1"; then
+    fail "$3: sequence numbers or timestamps do not increase"; return 1
+  fi
+  pass "$3: $(grep '^summary' "$1")"
+}
+
+echo "VMTEST kernel $(uname -r), $(ls /dev/video* | tr '\n' ' ')"
+[ -x "$toposlam" ] || { fail "no toposlam binary at $toposlam (build it first)"; echo "VMTEST DONE failures=$failures"; exit 1; }
+samples=$(cd "$(dirname "$0")/../data/rtabmap-samples/samples" && pwd)
+
+# Under TCG, starting a big dynamically linked program takes 10-20 s (toposlam maps ~250 libraries), so
+# the slow starts run side by side: the loopback writer, the vivid capture and the LCM listener.
+step "start: ffmpeg writer (bundled frames, 10 fps, YUYV 320x240), vivid capture, LCM listener"
+ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || fail "cannot set up multicast on lo"
+ffmpeg -nostdin -loglevel error -re -stream_loop 20 -framerate 10 -start_number 1 -i "$samples/%d.jpg" \
+  -vf scale=320:240 -pix_fmt yuyv422 -f v4l2 /dev/video0 &
+writer=$!
+if [ -x "$toposlamd" ]; then
+  "$toposlam" listen --channels TOPOSLAM_PLACE,TOPOSLAM_PLACE_EVENT,TOPOSLAM_STATUS --timeout 170 >listen.txt 2>&1 &
+  listener=$!
+fi
+
+# --- vivid (the kernel's test driver), BGR24 zero copy, with an unplug in the middle -----------------
+vivid=""
+for d in /sys/class/video4linux/video*; do
+  case "$(cat "$d/name")" in vivid*vid-cap*) vivid=/dev/$(basename "$d") ;; esac
+done
+if [ -z "$vivid" ]; then
+  fail "vivid: no vivid capture node"
+else
+  timeout 100 "$toposlam" capture "v4l2:$vivid?size=320x240&format=bgr24" -n 120 --timeout 90 \
+    >vivid.txt 2>&1 &
+  capture=$!
+  i=0
+  while [ $i -lt 600 ] && [ "$(grep -c '^frame ' vivid.txt)" -lt 10 ]; do sleep 0.1; i=$((i + 1)); done
+  v4l2-ctl -d "$vivid" -c disconnect=1 >/dev/null 2>&1 || echo "  (v4l2-ctl disconnect returned $?)"
+  echo "VMTEST vivid disconnected after $(grep -c '^frame ' vivid.txt) frames"
+  wait $capture
+  show vivid vivid.txt 400 | grep -v "| frame " | head -20
+  if check_capture_log vivid.txt 120 "vivid bgr24 capture across an unplug" &&
+     ! grep -q "zero_copy=1" vivid.txt; then
+    fail "vivid bgr24: frames were not zero-copy"
+  fi
+  if grep -q "camera lost" vivid.txt && grep -Eq "^summary .*reconnects=[1-9]" vivid.txt; then
+    pass "vivid reconnect: $(grep -m1 'camera lost' vivid.txt | sed 's/.*camera lost/camera lost/')"
+  else
+    fail "vivid reconnect: no reconnect seen after the disconnect control"
+  fi
+fi
+
+# --- v4l2loopback, YUYV from ffmpeg ---------------------------------------------------------------------
+step "loopback yuyv"
+if wait_for_writer YUYV; then
+  timeout 60 "$toposlam" capture "v4l2:/dev/video0?size=320x240&fps=10&format=yuyv" -n 30 --timeout 45 \
+    >loop-yuyv.txt 2>&1
+  show yuyv loop-yuyv.txt 6
+  check_capture_log loop-yuyv.txt 30 "v4l2loopback yuyv capture"
+else
+  fail "v4l2loopback yuyv: the ffmpeg writer never set a format"
+fi
+
+# --- toposlamd over LCM, on the same loopback camera ----------------------------------------------------
+if [ -x "$toposlamd" ]; then
+  . "$(dirname "$0")/guest-daemon.sh"
+else
+  echo "VMTEST SKIP toposlamd: not built in $build"
+fi
+kill $writer 2>/dev/null; wait $writer 2>/dev/null
+
+echo "VMTEST DONE failures=$failures"

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# The VM test (ctest label `vm`): boots Debian's own kernel under QEMU (TCG, no KVM needed), with
+# v4l2loopback and vivid loaded, shares this machine's root read-only over 9p and runs the real
+# toposlam binaries from BUILD_DIR inside (tests/vm/guest.sh). Passes when every guest check passed.
+# Exit 77 (skipped) only when QEMU cannot run here at all (no qemu-system-x86_64).
+# Usage: tests/vm/run-vm-test.sh BUILD_DIR [CACHE_DIR]    (CACHE_DIR default BUILD_DIR/vm-cache)
+# Environment: TOPOSLAM_VM_TIMEOUT (seconds for the whole boot-to-poweroff, default 170),
+#              TOPOSLAM_VM_SMP (guest CPUs, default 2),
+#              TOPOSLAM_VM_DAEMON (another toposlamd binary to run inside instead of BUILD_DIR's).
+set -euo pipefail
+
+build=$(cd "${1:?usage: run-vm-test.sh BUILD_DIR [CACHE_DIR]}" && pwd)
+cache=${2:-$build/vm-cache}
+here=$(cd "$(dirname "$0")" && pwd)
+scripts=$(cd "$here/../../scripts/vm" && pwd)
+started=$(date +%s)
+
+qemu=$(command -v qemu-system-x86_64 || true)
+if [ -z "$qemu" ]; then
+  echo "vm-test: SKIPPED: qemu-system-x86_64 is not installed (scripts/setup.sh installs qemu-system-x86)"
+  exit 77
+fi
+for tool in busybox cpio modprobe depmod dpkg-deb make gcc; do
+  command -v "$tool" >/dev/null || [ -x "/bin/$tool" ] || [ -x "/sbin/$tool" ] ||
+    { echo "vm-test: FAILED: $tool missing (run scripts/setup.sh)"; exit 1; }
+done
+[ -x "$build/src/apps/toposlam/toposlam" ] || { echo "vm-test: FAILED: build toposlam in $build first"; exit 1; }
+
+kver=$("$scripts/prepare.sh" "$cache")
+initrd="$cache/initrd.cpio.gz"
+"$scripts/build-initramfs.sh" "$cache" "$initrd"
+prepared=$(date +%s)
+echo "vm-test: kernel $kver prepared in $((prepared - started)) s; booting"
+
+log="$build/vm-test.log"
+timeout_s=${TOPOSLAM_VM_TIMEOUT:-170}
+set +e
+timeout --kill-after=5 "$timeout_s" "$qemu" -accel tcg -m 1024 -smp "${TOPOSLAM_VM_SMP:-2}" \
+  -kernel "$cache/vmlinuz" -initrd "$initrd" \
+  -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
+  -append "console=ttyS0 quiet loglevel=3 panic=-1 tsguest=$here/guest.sh tsbuild=$build${TOPOSLAM_VM_DAEMON:+ tsdaemon=$TOPOSLAM_VM_DAEMON}" \
+  -nographic -no-reboot -monitor none -serial stdio </dev/null >"$log" 2>&1
+qemu_rc=$?
+set -e
+finished=$(date +%s)
+tr -d '\r' <"$log" | grep -oE "VMTEST .*|^  [a-z0-9]+\| .*" | grep -v "| frame seq=" || true
+echo "vm-test: guest ran $((finished - prepared)) s (qemu exit $qemu_rc), whole test $((finished - started)) s; log $log"
+
+if [ "$qemu_rc" -eq 124 ] || [ "$qemu_rc" -eq 137 ]; then
+  echo "vm-test: FAILED: the VM did not power off within $timeout_s s"; exit 1
+fi
+grep -q "VMTEST BOOTED" "$log" || { echo "vm-test: FAILED: the guest did not boot (see $log)"; exit 1; }
+grep -q "VMTEST DONE failures=0" "$log" || { echo "vm-test: FAILED: guest checks failed"; exit 1; }
+if grep -q "VMTEST FAIL" "$log"; then echo "vm-test: FAILED"; exit 1; fi
+echo "vm-test: PASSED"
