@@ -17,5 +17,5 @@ if [ "${CI:-}" = "true" ] || [ "${TOPOSLAM_SANITIZERS:-0}" = "1" ]; then
   BUILD_TYPE=RelWithDebInfo scripts/build.sh "$root/build-asan" -DTOPOSLAM_SANITIZE=address,undefined \
     -DTOPOSLAM_WERROR=ON
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-    ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs" -LE slow ${CTEST_ARGS:-}
+    ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs" -LE "slow|vm|browser" ${CTEST_ARGS:-}
 fi

@@ -172,10 +172,13 @@ Fingerprint readFingerprint(std::istream& in) {
   if (backend > static_cast<std::uint8_t>(KeypointBackend::Akaze))
     throw std::runtime_error("fingerprint data corrupt: unknown keypoint backend");
   f.backend = static_cast<KeypointBackend>(backend);
-  f.edge_columns.resize(getCount(in, "edge count"));
-  for (int& c : f.edge_columns) c = get<std::int32_t>(in, "edge column");
-  f.subregions.resize(getCount(in, "subregion count"));
-  for (Subregion& s : f.subregions) {
+  // Containers grow element by element as the data arrives, so a corrupt count fails with
+  // "truncated" after reading what is there instead of allocating for the claimed size.
+  const std::uint32_t edge_count = getCount(in, "edge count");
+  for (std::uint32_t i = 0; i < edge_count; ++i) f.edge_columns.push_back(get<std::int32_t>(in, "edge column"));
+  const std::uint32_t subregion_count = getCount(in, "subregion count");
+  for (std::uint32_t i = 0; i < subregion_count; ++i) {
+    Subregion& s = f.subregions.emplace_back();
     s.column_begin = get<std::int32_t>(in, "subregion");
     s.column_end = get<std::int32_t>(in, "subregion");
     s.keypoint_begin = get<std::int32_t>(in, "subregion");
@@ -183,8 +186,9 @@ Fingerprint readFingerprint(std::istream& in) {
     in.read(reinterpret_cast<char*>(s.histogram.data()), sizeof(float) * kHistogramBins);
     if (!in) throw std::runtime_error("fingerprint data truncated while reading a histogram");
   }
-  f.keypoints.resize(getCount(in, "keypoint count"));
-  for (cv::KeyPoint& k : f.keypoints) {
+  const std::uint32_t keypoint_count = getCount(in, "keypoint count");
+  for (std::uint32_t i = 0; i < keypoint_count; ++i) {
+    cv::KeyPoint& k = f.keypoints.emplace_back();
     k.pt.x = get<float>(in, "keypoint");
     k.pt.y = get<float>(in, "keypoint");
     k.size = get<float>(in, "keypoint");
@@ -196,7 +200,7 @@ Fingerprint readFingerprint(std::istream& in) {
   const auto rows = get<std::int32_t>(in, "descriptor rows");
   const auto cols = get<std::int32_t>(in, "descriptor cols");
   const auto type = get<std::int32_t>(in, "descriptor type");
-  if (rows < 0 || cols < 0 || rows > static_cast<std::int32_t>(kMaxCount) || cols > 4096 ||
+  if (rows < 0 || cols < 0 || rows > static_cast<std::int32_t>(f.keypoints.size()) || cols > 4096 ||
       (rows > 0 && type != CV_8U && type != CV_32F))
     throw std::runtime_error("fingerprint data corrupt: bad descriptor matrix header");
   if (rows > 0) {

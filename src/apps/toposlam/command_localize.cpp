@@ -1,0 +1,240 @@
+// `toposlam localize --places PLACES.csv --queries QUERIES.csv`: localises every query image among the
+// labelled places (thesis section 3.3.2, PlaceLocalizer) and prints the thesis' Table 3.1 layout: for each
+// probability threshold, how many queries reach it and the precision among them. Optionally writes one
+// prediction per query (--out) and JSON (--json).
+//
+// Both CSV files hold `image,label` lines (paths relative to the CSV). Images sharing a label form one
+// place with several reference fingerprints. Bad lines and unreadable images are reported on stderr as
+// "file:line: problem" and skipped; the command fails only when no place or no query is usable.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "commands.hpp"
+#include "toposlam/core/json_writer.hpp"
+#include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/matching/labelled_image_list.hpp"
+#include "toposlam/matching/place_localizer.hpp"
+
+namespace toposlam::cli {
+
+namespace {
+
+struct LocalizeOptions {
+  std::string places;
+  std::string queries;
+  std::vector<double> thresholds = {0.5, 0.6, 0.7, 0.8, 0.9};
+  std::string out;
+  std::string keypoints = "orb";
+  bool normalise_counts = false;
+  bool json = false;
+};
+
+struct Prediction {
+  std::string image;
+  std::string expected;   ///< the query's label from the CSV
+  std::string predicted;  ///< label of the most probable place
+  double probability = 0.0;
+  bool correct = false;
+};
+
+struct ThresholdRow {
+  double threshold = 0.0;
+  int reached = 0;  ///< queries whose best probability is >= threshold
+  int correct = 0;  ///< among them, correctly labelled
+  double precision() const { return reached > 0 ? static_cast<double>(correct) / reached : 0.0; }
+};
+
+/// Progress on stderr for long runs: about every 10 % when there are at least 20 items.
+class Progress {
+ public:
+  Progress(std::string what, std::size_t total) : what_(std::move(what)), total_(total) {}
+  void step(std::size_t done) const {
+    if (total_ < 20) return;
+    const std::size_t every = (total_ + 9) / 10;
+    if (done % every == 0 || done == total_)
+      std::cerr << "toposlam localize: " << what_ << " " << done << "/" << total_ << "\n";
+  }
+
+ private:
+  std::string what_;
+  std::size_t total_;
+};
+
+/// Fingerprints one CSV entry; nullopt (and a "file:line: ..." message on stderr) when it is unusable.
+std::optional<Fingerprint> fingerprintEntry(const VpackExtractor& extractor, const LabelledImage& entry,
+                                            int& problems) {
+  std::string problem;
+  if (!std::filesystem::exists(entry.path)) {
+    problem = "no such file";
+  } else {
+    const cv::Mat image = cv::imread(entry.path, cv::IMREAD_COLOR);
+    if (image.empty()) {
+      problem = "not a readable image (corrupt or unsupported format)";
+    } else {
+      try {
+        return extractor.extract(image);
+      } catch (const std::exception& e) {
+        problem = e.what();
+      }
+    }
+  }
+  std::cerr << entry.source << ": image '" << entry.path << "': " << problem << "; skipped\n";
+  ++problems;
+  return std::nullopt;
+}
+
+LabelledImageList readListReporting(const std::string& csv, int& problems) {
+  LabelledImageList list = readLabelledImageList(csv);  // throws when the file cannot be opened
+  for (const std::string& p : list.problems) std::cerr << p << "; skipped\n";
+  problems += static_cast<int>(list.problems.size());
+  return list;
+}
+
+void writePredictions(const std::string& path, const std::vector<Prediction>& predictions) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write the predictions file");
+  out << "image,expected,label,probability,correct\n";
+  for (const Prediction& p : predictions)
+    out << p.image << "," << p.expected << "," << p.predicted << "," << std::fixed << std::setprecision(6)
+        << p.probability << "," << (p.correct ? 1 : 0) << "\n";
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+void runLocalize(const LocalizeOptions& o) {
+  int problems = 0;
+  const LabelledImageList place_list = readListReporting(o.places, problems);
+  const LabelledImageList query_list = readListReporting(o.queries, problems);
+
+  VpackConfig vpack;
+  vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
+  const VpackExtractor extractor(vpack);
+
+  // Places in order of their label's first appearance; several images with one label are its references.
+  std::vector<LabelledPlace> places;
+  std::map<std::string, std::size_t> place_index;
+  const Progress place_progress("place images", place_list.images.size());
+  for (std::size_t i = 0; i < place_list.images.size(); ++i) {
+    const LabelledImage& entry = place_list.images[i];
+    if (std::optional<Fingerprint> f = fingerprintEntry(extractor, entry, problems)) {
+      auto [it, inserted] = place_index.emplace(entry.label, places.size());
+      if (inserted) places.push_back({entry.label, {}});
+      places[it->second].references.push_back(std::move(*f));
+    }
+    place_progress.step(i + 1);
+  }
+  if (places.empty())
+    throw std::runtime_error(o.places + ": no usable place image (" + std::to_string(problems) +
+                             " problems reported above)");
+
+  PlaceLocalizerConfig config;
+  config.normalise_counts = o.normalise_counts;
+  const PlaceLocalizer localizer(config, std::move(places));
+
+  std::vector<Prediction> predictions;
+  int unknown_labels = 0;
+  const Progress query_progress("queries", query_list.images.size());
+  for (std::size_t i = 0; i < query_list.images.size(); ++i) {
+    const LabelledImage& entry = query_list.images[i];
+    if (std::optional<Fingerprint> f = fingerprintEntry(extractor, entry, problems)) {
+      const Localization l = localizer.localize(*f);
+      Prediction p;
+      p.image = entry.path;
+      p.expected = entry.label;
+      p.predicted = localizer.place(l.best_place).label;
+      p.probability = l.best_probability;
+      p.correct = p.predicted == p.expected;
+      if (place_index.count(entry.label) == 0) ++unknown_labels;
+      predictions.push_back(std::move(p));
+    }
+    query_progress.step(i + 1);
+  }
+  if (predictions.empty())
+    throw std::runtime_error(o.queries + ": no usable query image (" + std::to_string(problems) +
+                             " problems reported above)");
+  if (unknown_labels > 0)
+    std::cerr << "toposlam localize: " << unknown_labels
+              << " queries have a label that is no place's label (always counted as wrong)\n";
+
+  std::vector<ThresholdRow> rows;
+  for (double t : o.thresholds) {
+    ThresholdRow row{t, 0, 0};
+    for (const Prediction& p : predictions) {
+      if (p.probability + 1e-12 < t) continue;
+      ++row.reached;
+      row.correct += p.correct ? 1 : 0;
+    }
+    rows.push_back(row);
+  }
+  const auto all_correct = std::count_if(predictions.begin(), predictions.end(), [](const Prediction& p) { return p.correct; });
+  const double all_precision = static_cast<double>(all_correct) / static_cast<double>(predictions.size());
+  const double chance = 1.0 / static_cast<double>(localizer.placeCount());
+
+  if (!o.out.empty()) writePredictions(o.out, predictions);
+  if (problems > 0) std::cerr << "toposlam localize: " << problems << " problems reported above; run continued\n";
+
+  if (o.json) {
+    JsonWriter json(std::cout);
+    json.beginObject().field("places", localizer.placeCount()).field("place_images", static_cast<int>(place_list.images.size()));
+    json.field("queries", static_cast<int>(predictions.size())).field("problems", problems);
+    json.field("correct", static_cast<int>(all_correct)).field("precision", all_precision).field("chance", chance);
+    json.key("thresholds").beginArray();
+    for (const ThresholdRow& r : rows)
+      json.beginObject().field("threshold", r.threshold).field("images", r.reached).field("correct", r.correct)
+          .field("precision", r.precision()).endObject();
+    json.endArray();
+    json.key("predictions").beginArray();
+    for (const Prediction& p : predictions)
+      json.beginObject().field("image", p.image).field("expected", p.expected).field("label", p.predicted)
+          .field("probability", p.probability).field("correct", p.correct).endObject();
+    json.endArray().endObject();
+    std::cout << "\n";
+    return;
+  }
+  std::cout << localizer.placeCount() << " places, " << predictions.size() << " queries localised ("
+            << problems << " problems)\n";
+  std::cout << std::fixed << std::setprecision(2) << "all queries: " << all_correct << " correct, precision "
+            << 100.0 * all_precision << "% (chance " << 100.0 * chance << "%)\n";
+  std::cout << std::right << std::setw(10) << "Threshold" << std::setw(10) << "Images" << std::setw(12) << "Precision"
+            << "\n";
+  for (const ThresholdRow& r : rows) {
+    std::cout << std::setw(10) << std::setprecision(2) << r.threshold << std::setw(10) << r.reached;
+    if (r.reached > 0)
+      std::cout << std::setw(11) << 100.0 * r.precision() << "%\n";
+    else
+      std::cout << std::setw(12) << "-" << "\n";
+  }
+}
+
+}  // namespace
+
+void addLocalizeCommand(CLI::App& app) {
+  auto options = std::make_shared<LocalizeOptions>();
+  auto* cmd = app.add_subcommand("localize", "Localise query images among labelled places (thesis 3.3.2, Table 3.1)");
+  cmd->add_option("--places", options->places, "CSV of image,label: the places' reference images")
+      ->required();
+  cmd->add_option("--queries", options->queries, "CSV of image,label: query images with their true place")
+      ->required();
+  cmd->add_option("--thresholds", options->thresholds, "Probability thresholds of the table, comma-separated")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--out", options->out, "Write one prediction per query: image,expected,label,probability,correct");
+  cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
+      ->check(CLI::IsMember({"orb", "sift", "brisk", "akaze"}, CLI::ignore_case))
+      ->capture_default_str();
+  cmd->add_flag("--normalise-counts", options->normalise_counts,
+                "Divide each place's n-gram counts by the n-grams its representative could have had");
+  cmd->add_flag("--json", options->json, "Print JSON instead of the table");
+  cmd->callback([options] { runLocalize(*options); });
+}
+
+}  // namespace toposlam::cli
