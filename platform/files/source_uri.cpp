@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "toposlam/io/frame_source.hpp"
@@ -161,6 +162,15 @@ void SourceUri::requireOnly(const std::vector<std::string>& allowed) const {
     list += "rate";
     fail(*this, "unknown query key '" + key + "'" + (scheme.empty() ? "" : " for " + scheme + ":") + "; allowed: " + list);
   }
+}
+
+std::string absoluteSourceUri(const std::string& uri) {
+  const SourceUri parsed = parseSourceUri(uri);
+  if (!parsed.scheme.empty() && parsed.scheme != "images" && parsed.scheme != "video") return uri;
+  const std::size_t path_start = parsed.scheme.empty() ? 0 : parsed.scheme.size() + 1;
+  const std::string query = uri.substr(std::min(uri.size(), path_start + parsed.path.size()));
+  const std::string prefix = parsed.scheme.empty() ? "" : parsed.scheme + ":";
+  return prefix + std::filesystem::absolute(parsed.path).lexically_normal().string() + query;
 }
 
 }  // namespace toposlam

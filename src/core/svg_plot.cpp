@@ -1,4 +1,5 @@
 // SVG line plots: map data to the plot area, draw grid, ticks, series, markers, legend.
+#include "toposlam/core/markup_escape.hpp"
 #include "toposlam/core/svg_plot.hpp"
 
 #include <algorithm>
@@ -10,30 +11,6 @@
 namespace toposlam {
 
 namespace {
-
-std::string escapeXml(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 std::string number(double value) {
   char buffer[32];
@@ -129,7 +106,7 @@ std::string renderSvgLinePlot(const SvgPlot& plot) {
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   if (!plot.title.empty()) {
     svg << "<text x=\"" << number(width / 2.0) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">"
-        << escapeXml(plot.title) << "</text>\n";
+        << escapeMarkup(plot.title) << "</text>\n";
   }
 
   // Grid and ticks.
@@ -160,33 +137,33 @@ std::string renderSvgLinePlot(const SvgPlot& plot) {
       << "\" height=\"" << number(area_h) << "\" fill=\"none\" stroke=\"#333333\"/>\n";
   if (!plot.x_label.empty()) {
     svg << "<text x=\"" << number(left + area_w / 2) << "\" y=\"" << number(height - 10.0)
-        << "\" text-anchor=\"middle\">" << escapeXml(plot.x_label) << "</text>\n";
+        << "\" text-anchor=\"middle\">" << escapeMarkup(plot.x_label) << "</text>\n";
   }
   if (!plot.y_label.empty()) {
     svg << "<text transform=\"translate(16 " << number(top + area_h / 2)
-        << ") rotate(-90)\" text-anchor=\"middle\">" << escapeXml(plot.y_label) << "</text>\n";
+        << ") rotate(-90)\" text-anchor=\"middle\">" << escapeMarkup(plot.y_label) << "</text>\n";
   }
 
   // Reference lines.
   for (const SvgLine& l : plot.horizontal_lines) {
     if (!inside_y(l.value)) continue;
     svg << "<line x1=\"" << number(left) << "\" y1=\"" << number(py(l.value)) << "\" x2=\""
-        << number(left + area_w) << "\" y2=\"" << number(py(l.value)) << "\" stroke=\"" << escapeXml(l.colour)
+        << number(left + area_w) << "\" y2=\"" << number(py(l.value)) << "\" stroke=\"" << escapeMarkup(l.colour)
         << "\" stroke-width=\"1\"" << (l.dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>\n";
     if (!l.label.empty()) {
       svg << "<text x=\"" << number(left + area_w - 4) << "\" y=\"" << number(py(l.value) - 3)
-          << "\" text-anchor=\"end\" fill=\"" << escapeXml(l.colour) << "\">" << escapeXml(l.label)
+          << "\" text-anchor=\"end\" fill=\"" << escapeMarkup(l.colour) << "\">" << escapeMarkup(l.label)
           << "</text>\n";
     }
   }
   for (const SvgLine& l : plot.vertical_lines) {
     if (!inside_x(l.value)) continue;
     svg << "<line x1=\"" << number(px(l.value)) << "\" y1=\"" << number(top) << "\" x2=\""
-        << number(px(l.value)) << "\" y2=\"" << number(top + area_h) << "\" stroke=\"" << escapeXml(l.colour)
+        << number(px(l.value)) << "\" y2=\"" << number(top + area_h) << "\" stroke=\"" << escapeMarkup(l.colour)
         << "\" stroke-width=\"1\"" << (l.dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>\n";
     if (!l.label.empty()) {
       svg << "<text x=\"" << number(px(l.value) + 3) << "\" y=\"" << number(top + 11) << "\" fill=\""
-          << escapeXml(l.colour) << "\">" << escapeXml(l.label) << "</text>\n";
+          << escapeMarkup(l.colour) << "\">" << escapeMarkup(l.label) << "</text>\n";
     }
   }
 
@@ -197,7 +174,7 @@ std::string renderSvgLinePlot(const SvgPlot& plot) {
     std::size_t in_run = 0;
     auto flush_run = [&] {
       if (in_run > 0) {
-        svg << "<polyline fill=\"none\" stroke=\"" << escapeXml(s.colour) << "\" stroke-width=\""
+        svg << "<polyline fill=\"none\" stroke=\"" << escapeMarkup(s.colour) << "\" stroke-width=\""
             << number(s.stroke_width) << "\" points=\"" << points.str() << "\"/>\n";
       }
       points.str("");
@@ -222,9 +199,9 @@ std::string renderSvgLinePlot(const SvgPlot& plot) {
     if (s.label.empty()) continue;
     const double x = left + area_w - 150;
     svg << "<line x1=\"" << number(x) << "\" y1=\"" << number(legend_y - 4) << "\" x2=\"" << number(x + 20)
-        << "\" y2=\"" << number(legend_y - 4) << "\" stroke=\"" << escapeXml(s.colour)
+        << "\" y2=\"" << number(legend_y - 4) << "\" stroke=\"" << escapeMarkup(s.colour)
         << "\" stroke-width=\"2\"/>\n"
-        << "<text x=\"" << number(x + 26) << "\" y=\"" << number(legend_y) << "\">" << escapeXml(s.label)
+        << "<text x=\"" << number(x + 26) << "\" y=\"" << number(legend_y) << "\">" << escapeMarkup(s.label)
         << "</text>\n";
     legend_y += 16;
   }

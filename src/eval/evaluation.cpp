@@ -1,4 +1,5 @@
 // Run folder + ground truth -> EvalResult, and its text / JSON / HTML forms (see evaluation.hpp).
+#include "toposlam/core/markup_escape.hpp"
 #include "toposlam/eval/evaluation.hpp"
 
 #include <algorithm>
@@ -464,29 +465,6 @@ std::vector<Table> tables(const EvalResult& r) {
   return out;
 }
 
-std::string escapeHtml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 std::string formatEvalText(const EvalResult& r) {
@@ -518,17 +496,17 @@ std::string formatEvalText(const EvalResult& r) {
 std::string formatEvalHtml(const EvalResult& r) {
   std::ostringstream out;
   for (const Table& t : tables(r)) {
-    out << "<h3 class=\"eval\">" << escapeHtml(t.title) << "</h3>\n<table class=\"eval\">\n<tr>";
-    for (const auto& h : t.header) out << "<th>" << escapeHtml(h) << "</th>";
+    out << "<h3 class=\"eval\">" << escapeMarkup(t.title) << "</h3>\n<table class=\"eval\">\n<tr>";
+    for (const auto& h : t.header) out << "<th>" << escapeMarkup(h) << "</th>";
     out << "</tr>\n";
     for (const auto& row : t.rows) {
       out << "<tr>";
-      for (const auto& cell : row) out << "<td>" << escapeHtml(cell) << "</td>";
+      for (const auto& cell : row) out << "<td>" << escapeMarkup(cell) << "</td>";
       out << "</tr>\n";
     }
     out << "</table>\n";
   }
-  for (const auto& note : r.notes) out << "<p class=\"note\">" << escapeHtml(note) << "</p>\n";
+  for (const auto& note : r.notes) out << "<p class=\"note\">" << escapeMarkup(note) << "</p>\n";
   return out.str();
 }
 

@@ -1,6 +1,7 @@
 // The self-contained HTML report (see report.hpp). Layout decisions: one column, figures 1100 px wide,
 // thumbnails 96 px wide; the topology is laid out on a circle in order of first visit (the order the
 // robot found the nodes), so a loop traversed twice draws as a ring.
+#include "toposlam/core/markup_escape.hpp"
 #include "toposlam/eval/report.hpp"
 
 #include <algorithm>
@@ -17,29 +18,6 @@ namespace toposlam::eval {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-std::string escapeHtml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 std::string num(double v, int decimals = 1) {
   char buffer[48];
@@ -68,7 +46,7 @@ std::string stripSvg(const std::vector<int>& indices, const std::string& label, 
   std::ostringstream svg;
   const int label_width = 110, height = 26;
   svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height << "\">";
-  svg << "<text x=\"0\" y=\"17\" font-size=\"13\" font-family=\"sans-serif\">" << escapeHtml(label)
+  svg << "<text x=\"0\" y=\"17\" font-size=\"13\" font-family=\"sans-serif\">" << escapeMarkup(label)
       << "</text>";
   const double w = n > 0 ? static_cast<double>(width - label_width) / static_cast<double>(n) : 0.0;
   // Merge runs of one colour into one rectangle (a 3000-frame strip stays small).
@@ -338,7 +316,7 @@ std::string topologyMarkup(const RunData& run, const std::vector<std::string>& t
            << "font-family=\"sans-serif\" text-anchor=\"middle\">node " << node->id << "</text><text x=\""
            << num(x) << "\" y=\"" << num(top + thumb_h + 26)
            << "\" font-size=\"11\" font-family=\"sans-serif\" "
-           << "text-anchor=\"middle\">places " << escapeHtml(places) << "</text>\n";
+           << "text-anchor=\"middle\">places " << escapeMarkup(places) << "</text>\n";
       continue;
     }
     html << "<div class=\"node\" style=\"left:" << num(x - thumb_w / 2 - 4, 0)
@@ -350,7 +328,7 @@ std::string topologyMarkup(const RunData& run, const std::vector<std::string>& t
       html << "<div class=\"nothumb\" style=\"width:" << thumb_w << "px;height:" << thumb_h
            << "px\">no frame</div>";
     }
-    html << "<div class=\"label\">node " << node->id << "<br>places " << escapeHtml(places)
+    html << "<div class=\"label\">node " << node->id << "<br>places " << escapeMarkup(places)
          << "</div></div>\n";
   }
   html << (svg_only ? "</svg>\n" : "</div>\n");
@@ -393,7 +371,7 @@ std::string renderReportHtml(const ReportInputs& in) {
   const bool by_node = hasNodes(run);
   const std::size_t n = run.frames.size();
   std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << escapeHtml(in.title)
+  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << escapeMarkup(in.title)
        << "</title>\n<style>\n"
           "body{font-family:sans-serif;margin:20px;max-width:1200px;color:#222}\n"
           "h2{border-bottom:1px solid #ccc;padding-bottom:4px;margin-top:32px}\n"
@@ -410,7 +388,7 @@ std::string renderReportHtml(const ReportInputs& in) {
           "table.eval td,table.eval th{border:1px solid #ccc;padding:3px 10px;text-align:right}\n"
           ".note{color:#a33}\n.legend span{display:inline-block;width:12px;height:12px;margin:0 4px 0 12px}\n"
           "</style></head><body>\n";
-  html << "<h1>" << escapeHtml(in.title) << "</h1>\n";
+  html << "<h1>" << escapeMarkup(in.title) << "</h1>\n";
   int nodes = 0;
   double best_p = std::nan("");
   if (run.topology) {
@@ -421,8 +399,8 @@ std::string renderReportHtml(const ReportInputs& in) {
        << " dropped)";
   if (run.topology)
     html << ", " << nodes << " nodes in the most probable topology (p = " << num(best_p, 3) << ")";
-  html << ". Run folder <code>" << escapeHtml(run.dir) << "</code>.</p>\n";
-  for (const auto& w : in.warnings) html << "<p class=\"note\">" << escapeHtml(w) << "</p>\n";
+  html << ". Run folder <code>" << escapeMarkup(run.dir) << "</code>.</p>\n";
+  for (const auto& w : in.warnings) html << "<p class=\"note\">" << escapeMarkup(w) << "</p>\n";
 
   // 1. strip
   html << "<h2>Frames coloured by " << (by_node ? "node" : "place") << "</h2>\n";
@@ -509,7 +487,7 @@ std::string renderReportHtml(const ReportInputs& in) {
   // 6. evaluation
   html << "<h2>Evaluation against ground truth</h2>\n";
   if (in.eval) {
-    html << "<p>Ground truth: <code>" << escapeHtml(in.eval->truth_path) << "</code> (" << in.eval->truth_kind
+    html << "<p>Ground truth: <code>" << escapeMarkup(in.eval->truth_path) << "</code> (" << in.eval->truth_kind
          << ").</p>\n";
     html << formatEvalHtml(*in.eval);
     if (in.eval->loop_closure && !in.eval->loop_closure->points.empty()) {

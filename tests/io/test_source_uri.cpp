@@ -1,6 +1,8 @@
 // Tests of frame-source URI parsing and its typed getters' error messages.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+
 #include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/source_uri.hpp"
 
@@ -45,4 +47,14 @@ TEST_CASE("GIVEN bad query values WHEN read THEN the error names the key, the va
                     Catch::Contains("bogus") && Catch::Contains("allowed: fps, size"));
   CHECK_THROWS_WITH(parseSourceUri(""), Catch::Contains("empty"));
   CHECK_THROWS_WITH(parseSourceUri("sim:office?fps=1&fps=2"), Catch::Contains("fps") && Catch::Contains("twice"));
+}
+
+TEST_CASE("GIVEN file-source URIs WHEN made absolute THEN relative paths resolve against the working directory and queries stay", "[io]") {
+  const std::string cwd = std::filesystem::current_path().lexically_normal().string();
+  CHECK(absoluteSourceUri("images:frames/../run1?rate=5") == "images:" + cwd + "/run1?rate=5");
+  CHECK(absoluteSourceUri("video:clip.mp4") == "video:" + cwd + "/clip.mp4");
+  CHECK(absoluteSourceUri("run2") == cwd + "/run2");
+  CHECK(absoluteSourceUri("images:/data/img?.jpg?rate=2") == "images:/data/img?.jpg?rate=2");
+  CHECK(absoluteSourceUri("sim:office?route=loop2") == "sim:office?route=loop2");
+  CHECK(absoluteSourceUri("v4l2:/dev/video0?fps=30") == "v4l2:/dev/video0?fps=30");
 }

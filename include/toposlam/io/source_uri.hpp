@@ -38,4 +38,9 @@ struct SourceUri {
 /// Throws FrameSourceError on an empty URI, an empty key or a duplicated key.
 SourceUri parseSourceUri(const std::string& uri);
 
+/// `uri` with the relative path of a file source (`images:`, `video:` or a plain path) made absolute and
+/// normalised, its query kept; other schemes unchanged. Run folders record their sources this way so
+/// `toposlam report` finds the frames from any working directory.
+std::string absoluteSourceUri(const std::string& uri);
+
 }  // namespace toposlam

@@ -79,6 +79,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchTopology(*bench);
   addBenchSegmentation(*bench);
   addBenchSim(*bench);
+  addBenchMatching(*bench);
 }
 
 }  // namespace toposlam::cli

@@ -13,7 +13,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
-#include <sstream>
+#include <optional>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>

@@ -31,6 +31,7 @@
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/frame_source.hpp"
+#include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
@@ -244,6 +245,10 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   std::vector<std::int64_t> place_nodes;
   for (std::size_t p = 0; p < all.places.size(); ++p) {
     place_nodes.push_back(assignment[static_cast<std::size_t>(first_observation) + p]);
+  }
+  {
+    std::ofstream out = openOutput(out_dir / "source.txt");
+    for (const std::string& uri : o.sources) out << absoluteSourceUri(uri) << "\n";
   }
   {
     std::ofstream out = openOutput(out_dir / "frames.csv");

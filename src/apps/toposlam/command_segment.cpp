@@ -18,6 +18,7 @@
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/frame_source.hpp"
+#include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
 #ifdef TOPOSLAM_HAVE_SOURCES
@@ -128,6 +129,10 @@ void runSegment(const SegmentOptions& o) {
                              std::to_string(source->skippedFrames() + refused) + " skipped)");
   }
   const fs::path dir(o.out);
+  {
+    std::ofstream out = openOutput(dir / "source.txt");
+    out << absoluteSourceUri(o.source) << "\n";
+  }
   {
     std::ofstream out = openOutput(dir / "frames.csv");
     writeFramesCsv(out, run);

@@ -15,11 +15,14 @@ void addSimCommand(CLI::App& app);
 void addEvalCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addListenCommand(CLI::App& app);
+void addSimilarityCommand(CLI::App& app);
+void addLocalizeCommand(CLI::App& app);
 
 // Sub-benchmarks of `toposlam bench`, each in its module's bench_<module>.cpp (called from command_bench.cpp).
 void addBenchFingerprint(CLI::App& bench);
 void addBenchTopology(CLI::App& bench);
 void addBenchSegmentation(CLI::App& bench);
 void addBenchSim(CLI::App& bench);
+void addBenchMatching(CLI::App& bench);
 
 }  // namespace toposlam::cli

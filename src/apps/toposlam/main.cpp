@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   toposlam::cli::addEvalCommand(app);
   toposlam::cli::addReportCommand(app);
   toposlam::cli::addListenCommand(app);
+  toposlam::cli::addSimilarityCommand(app);
+  toposlam::cli::addLocalizeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
