@@ -7,7 +7,7 @@ PACKAGES=(
   libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
   graphviz
-  chromium  # headless browser check of `toposlam report` (ctest -L browser); ~30 s to install
+  chromium chromium-driver python3  # browser check of `toposlam report` over WebDriver (ctest -L browser)
   qemu-system-x86 busybox-static cpio kmod v4l-utils ffmpeg iproute2  # VM camera test (tests/vm)
 )
 

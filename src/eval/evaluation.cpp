@@ -28,9 +28,23 @@ RunData loadRun(const std::string& dir) {
                        ": missing; give a folder written by `toposlam segment` or `toposlam map`");
   }
   run.frames = loadFrames((root / "frames.csv").string());
-  if (fs::exists(root / "places.csv")) run.places = loadPlaces((root / "places.csv").string());
-  if (fs::exists(root / "dropped_places.csv"))
-    run.dropped_places = loadPlaces((root / "dropped_places.csv").string());
+  const auto frame_count = static_cast<std::int64_t>(run.frames.size());
+  // Places must lie inside frames.csv (loadPlaces already checked 0 <= first <= representative <= last).
+  auto loadPlacesWithin = [&](const std::string& name) {
+    const std::string path = (root / name).string();
+    std::vector<PlaceRecord> places = loadPlaces(path);
+    for (const PlaceRecord& p : places) {
+      if (p.last >= frame_count) {
+        throw RunFileError(path + ":" + std::to_string(p.line) + ": place " + std::to_string(p.place) +
+                           " spans frames " + std::to_string(p.first) + ".." + std::to_string(p.last) +
+                           " but frames.csv has " + std::to_string(frame_count) +
+                           " frames (a damaged or mixed-up run folder)");
+      }
+    }
+    return places;
+  };
+  if (fs::exists(root / "places.csv")) run.places = loadPlacesWithin("places.csv");
+  if (fs::exists(root / "dropped_places.csv")) run.dropped_places = loadPlacesWithin("dropped_places.csv");
   if (fs::exists(root / "topology.json")) run.topology = loadTopology((root / "topology.json").string());
   if (fs::exists(root / "timing.csv")) run.timing = loadTiming((root / "timing.csv").string());
   run.traversal_starts.push_back(0);
@@ -47,6 +61,18 @@ std::vector<std::int64_t> splitTraversals(std::int64_t frame_count, int count) {
   return starts;
 }
 
+namespace {
+/// First frame of each traversal from the labels' traversal column; empty when the column is absent.
+std::vector<std::int64_t> labelTraversalStarts(const std::vector<LabelRow>& labels) {
+  if (labels.empty() || labels.front().traversal < 0) return {};
+  std::vector<std::int64_t> starts{0};
+  for (std::size_t f = 1; f < labels.size(); ++f) {
+    if (labels[f].traversal != labels[f - 1].traversal) starts.push_back(static_cast<std::int64_t>(f));
+  }
+  return starts;
+}
+}  // namespace
+
 Truth loadTruth(const std::string& path) {
   Truth truth;
   truth.path = path;
@@ -57,6 +83,7 @@ Truth loadTruth(const std::string& path) {
     if (labels) {
       truth.kind = Truth::Kind::Labels;
       truth.labels = loadLabels(path);
+      truth.traversal_starts = labelTraversalStarts(truth.labels);
     } else {
       truth.kind = Truth::Kind::Pairs;
       truth.pairs = loadLoopClosurePairs(path);
@@ -72,7 +99,10 @@ Truth loadTruth(const std::vector<std::string>& paths) {
   if (paths.empty())
     throw std::invalid_argument("--truth: give labels.csv, a loop-closure matrix image or a pairs CSV");
   Truth truth = loadTruth(paths.front());
-  truth.file_starts = {0};
+  if (paths.size() > 1 && truth.traversal_starts.empty()) {
+    truth.traversal_starts = {0};
+    for (LabelRow& row : truth.labels) row.traversal = 0;
+  }
   for (std::size_t k = 1; k < paths.size(); ++k) {
     const Truth more = loadTruth(paths[k]);
     if (truth.kind != Truth::Kind::Labels || more.kind != Truth::Kind::Labels) {
@@ -80,10 +110,15 @@ Truth loadTruth(const std::vector<std::string>& paths) {
                                   paths[k] + " or " + paths.front() +
                                   " is a loop-closure matrix or pairs file");
     }
+    // Each file starts a traversal; a file with a traversal column may hold several.
     const auto offset = static_cast<std::int64_t>(truth.labels.size());
-    truth.file_starts.push_back(offset);
+    const std::vector<std::int64_t> more_starts =
+        more.traversal_starts.empty() ? std::vector<std::int64_t>{0} : more.traversal_starts;
+    for (std::int64_t start : more_starts) truth.traversal_starts.push_back(offset + start);
+    const int traversal_offset = truth.labels.empty() ? 0 : std::max(0, truth.labels.back().traversal) + 1;
     for (LabelRow row : more.labels) {
       row.frame += offset;
+      row.traversal = traversal_offset + std::max(0, row.traversal);
       truth.labels.push_back(row);
     }
     truth.path += "+" + paths[k];
@@ -163,9 +198,28 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
   result.places = static_cast<int>(run.places.size());
   result.dropped_places = static_cast<int>(run.dropped_places.size());
   const std::int64_t n = static_cast<std::int64_t>(run.frames.size());
-  const std::vector<std::int64_t> starts = options.traversals > 0 ? splitTraversals(n, options.traversals)
-                                           : truth.file_starts.size() > 1 ? truth.file_starts
-                                                                          : run.traversal_starts;
+  // loadRun checks this with file and line; a RunData built in memory gets the same refusal here.
+  for (const auto* list : {&run.places, &run.dropped_places}) {
+    for (const PlaceRecord& p : *list) {
+      if (p.first < 0 || p.last >= n || p.representative < p.first || p.representative > p.last) {
+        throw RunFileError(run.dir + ": place " + std::to_string(p.place) + " (frames " +
+                           std::to_string(p.first) + ".." + std::to_string(p.last) + ", representative " +
+                           std::to_string(p.representative) + ") does not lie inside the " +
+                           std::to_string(n) + " frames of frames.csv");
+      }
+    }
+  }
+  // Traversals: the labels say (traversal column, one per labels file) > --traversals N (even split) >
+  // one per source of `map`.
+  const std::vector<std::int64_t> starts = !truth.traversal_starts.empty() ? truth.traversal_starts
+                                           : options.traversals > 0 ? splitTraversals(n, options.traversals)
+                                                                    : run.traversal_starts;
+  if (!truth.traversal_starts.empty() && options.traversals > 0 &&
+      static_cast<int>(truth.traversal_starts.size()) != options.traversals) {
+    result.notes.push_back("--traversals " + std::to_string(options.traversals) +
+                           " ignored: the ground truth has " + std::to_string(truth.traversal_starts.size()) +
+                           " traversals (labels.csv column traversal, or one per labels file)");
+  }
   result.traversals = static_cast<int>(starts.size());
   result.traversal_starts = starts;
   result.min_gap = options.min_gap >= 0 ? options.min_gap : (truth.kind == Truth::Kind::Labels ? 0 : 25);
@@ -230,15 +284,13 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
     result.boundaries =
         scoreBoundaries(predictedCuts(run, starts), roomBoundaries(rooms, starts), options.tolerance);
     std::vector<std::int64_t> reps;
-    for (const auto& p : run.places) {
-      if (p.representative < n) reps.push_back(p.representative);
-    }
+    for (const auto& p : run.places) reps.push_back(p.representative);
     result.places_per_traversal = placesPerTraversal(reps, rooms, starts);
     result.consistency = crossTraversalConsistency(reps, rooms, starts);
     if (has_nodes) {
       std::vector<int> place_node, place_room;
       for (const auto& p : run.places) {
-        if (p.node < 0 || p.last >= n) continue;
+        if (p.node < 0) continue;
         place_node.push_back(p.node);
         int r = rooms[static_cast<std::size_t>(p.representative)];
         if (r < 0) {
@@ -392,8 +444,8 @@ std::vector<Table> tables(const EvalResult& r) {
   }
   if (r.loop_closure) {
     const PrCurve& c = *r.loop_closure;
-    Table t{"Loop closure (frame pairs on the same node; pairs within " + std::to_string(r.min_gap) +
-                " frames not evaluated)",
+    Table t{"Loop closure (frame pairs on one node in different visits; pairs within " +
+                std::to_string(r.min_gap) + " frames not evaluated)",
             {"measure", "value"},
             {}};
     t.rows.push_back({"ground-truth pairs", std::to_string(c.positives)});

@@ -61,22 +61,19 @@ LoopClosureTruth truthFromMatrix(const LoopClosureMatrix& matrix, int min_gap) {
   return truth;
 }
 
-namespace {
-/// Visit number per frame: increments whenever the room differs from the last room seen; -1 on doorways.
-std::vector<int> visitIds(const std::vector<int>& rooms) {
-  std::vector<int> visit(rooms.size(), -1);
-  int current = -1, last_room = -1;
-  for (std::size_t f = 0; f < rooms.size(); ++f) {
-    if (rooms[f] < 0) continue;
-    if (rooms[f] != last_room) {
+std::vector<int> visitIds(const std::vector<int>& labels) {
+  std::vector<int> visit(labels.size(), -1);
+  int current = -1, last_label = -1;
+  for (std::size_t f = 0; f < labels.size(); ++f) {
+    if (labels[f] < 0) continue;
+    if (labels[f] != last_label) {
       ++current;
-      last_room = rooms[f];
+      last_label = labels[f];
     }
     visit[f] = current;
   }
   return visit;
 }
-}  // namespace
 
 LoopClosureTruth truthFromRooms(const std::vector<int>& rooms, int min_gap) {
   const int n = static_cast<int>(rooms.size());
@@ -96,6 +93,9 @@ LoopClosureTruth truthFromRooms(const std::vector<int>& rooms, int min_gap) {
 
 std::vector<ScoredPair> pairsFromAssignments(const std::vector<int>& node_of_frame,
                                              const std::vector<double>& probability_of_frame) {
+  // A predicted visit is a run of frames on one node (frames without a node do not end it), just as a
+  // true visit is a run of frames in one room: only pairs from different visits claim a loop closure.
+  const std::vector<int> visit = visitIds(node_of_frame);
   std::map<int, std::vector<int>> frames_of_node;
   for (std::size_t f = 0; f < node_of_frame.size(); ++f) {
     if (node_of_frame[f] >= 0) frames_of_node[node_of_frame[f]].push_back(static_cast<int>(f));
@@ -105,6 +105,7 @@ std::vector<ScoredPair> pairsFromAssignments(const std::vector<int>& node_of_fra
     for (std::size_t a = 0; a < frames.size(); ++a) {
       for (std::size_t b = 0; b < a; ++b) {
         const auto later = static_cast<std::size_t>(frames[a]);
+        if (visit[later] == visit[static_cast<std::size_t>(frames[b])]) continue;
         const double p = later < probability_of_frame.size() ? probability_of_frame[later] : 1.0;
         pairs.push_back(ScoredPair{frames[a], frames[b], p});
       }

@@ -146,7 +146,7 @@ SvgPlot timingPlot(const RunData& run) {
 
 SvgPlot precisionRecallPlot(const PrCurve& curve) {
   SvgPlot plot;
-  plot.title = "loop closure: precision vs. recall (frame pairs on the same node, by node probability)";
+  plot.title = "loop closure: precision vs. recall (score: node probability)";
   plot.x_label = "recall";
   plot.y_label = "precision";
   plot.width = 600;

@@ -96,7 +96,8 @@ std::int64_t CsvTable::integer(std::size_t row, int col) const {
 
 std::vector<LabelRow> loadLabels(const std::string& path) {
   const CsvTable t = readCsv(path);
-  const int frame = t.column("frame"), room = t.column("room"), time = t.column("time", false);
+  const int frame = t.column("frame"), room = t.column("room"), time = t.column("time", false),
+            traversal = t.column("traversal", false);
   std::vector<LabelRow> rows;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     LabelRow row;
@@ -109,6 +110,15 @@ std::vector<LabelRow> loadLabels(const std::string& path) {
     }
     if (row.room < -1)
       throw RunFileError(where(t, r) + ": room " + std::to_string(row.room) + " must be >= -1");
+    if (traversal >= 0) {
+      row.traversal = static_cast<int>(t.integer(r, traversal));
+      const int previous = rows.empty() ? 0 : rows.back().traversal;
+      if (row.traversal < previous) {
+        throw RunFileError(where(t, r) + ": traversal " + std::to_string(row.traversal) +
+                           " after traversal " + std::to_string(previous) +
+                           " (must be >= 0 and never decrease)");
+      }
+    }
     rows.push_back(row);
   }
   return rows;
@@ -146,6 +156,7 @@ std::vector<PlaceRecord> loadPlaces(const std::string& path) {
   std::vector<PlaceRecord> rows;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     PlaceRecord row;
+    row.line = t.lines[r];
     row.place = static_cast<int>(t.integer(r, place));
     row.first = t.integer(r, first);
     row.last = t.integer(r, last);
@@ -154,8 +165,9 @@ std::vector<PlaceRecord> loadPlaces(const std::string& path) {
     row.node = node >= 0 && !t.rows[r][static_cast<std::size_t>(node)].empty()
                    ? static_cast<int>(t.integer(r, node))
                    : -1;
-    if (row.first > row.last || row.representative < row.first || row.representative > row.last) {
-      throw RunFileError(where(t, r) + ": need first <= representative <= last, got " +
+    if (row.first < 0 || row.first > row.last || row.representative < row.first ||
+        row.representative > row.last) {
+      throw RunFileError(where(t, r) + ": need 0 <= first <= representative <= last, got " +
                          std::to_string(row.first) + " <= " + std::to_string(row.representative) +
                          " <= " + std::to_string(row.last));
     }

@@ -39,14 +39,14 @@ SCENARIO(
 SCENARIO(
     "GIVEN rooms 0,1,0,1 (four visits) and nodes 0,1,0,0 WHEN the loop-closure curve is computed THEN recall "
     "at 100 % precision is 0.5") {
-  // Positives: (2,0) and (3,1). Predicted pairs (same node 0): (2,0) score 0.9 TP, (3,0) and (3,2) score 0.4
-  // FP.
+  // Positives: (2,0) and (3,1). Predicted pairs (node 0 in different visits: frame 0, then frames 2-3):
+  // (2,0) score 0.9 TP, (3,0) score 0.4 FP; (3,2) is within one visit of node 0, no loop closure.
   const LoopClosureTruth truth = truthFromRooms({0, 1, 0, 1}, 0);
   CHECK(truth.positives() == 2);
   CHECK(truth.at(1, 0) == 0);
   CHECK(truth.at(0, 2) == 1);
   const auto pairs = pairsFromAssignments({0, 1, 0, 0}, {1.0, 1.0, 0.9, 0.4});
-  CHECK(pairs.size() == 3);
+  CHECK(pairs.size() == 2);
   const PrCurve curve = precisionRecall(truth, pairs);
   REQUIRE(curve.points.size() == 2);
   CHECK(curve.points[0].threshold == Approx(0.9));
@@ -54,11 +54,54 @@ SCENARIO(
   CHECK(curve.points[0].false_positives == 0);
   CHECK(curve.points[0].precision == Approx(1.0));
   CHECK(curve.points[0].recall == Approx(0.5));
-  CHECK(curve.points[1].false_positives == 2);
-  CHECK(curve.points[1].precision == Approx(1.0 / 3.0));
+  CHECK(curve.points[1].false_positives == 1);
+  CHECK(curve.points[1].precision == Approx(0.5));
   CHECK(curve.recall_at_full_precision == Approx(0.5));
   CHECK(curve.threshold_at_full_precision == Approx(0.9));
-  CHECK(curve.average_precision == Approx(0.5));  // 0.5 x 1 + 0 x 1/3
+  CHECK(curve.average_precision == Approx(0.5));  // 0.5 x 1 + 0 x 1/2
+}
+
+SCENARIO(
+    "GIVEN node and room labels with doorway frames WHEN visits are numbered THEN a visit is a run of one "
+    "label and -1 frames neither end nor start one") {
+  CHECK(visitIds({0, 0, -1, 0, 1, 1, -1, 0}) == std::vector<int>{0, 0, -1, 0, 1, 1, -1, 2});
+  CHECK(visitIds({-1, 3, 3, 5, 3}) == std::vector<int>{-1, 0, 0, 1, 2});
+  CHECK(visitIds({}).empty());
+}
+
+SCENARIO(
+    "GIVEN a first place that straddles a room change WHEN loop closures are scored THEN pairs inside the "
+    "place are no prediction and recall at 100 % precision is that of the real revisit") {
+  // Places: P0 frames 0-3 (rooms 0,0,1,1) on node 0 at p = 1.0; P1 frames 4-5 (room 2) on node 1 at 0.95;
+  // P2 frames 6-7 (room 0) on a new node 2 at 0.9 (a missed closure); P3 frames 8-9 (room 2) back on node 1
+  // at 0.8 (a right closure).
+  const std::vector<int> rooms = {0, 0, 1, 1, 2, 2, 0, 0, 2, 2};
+  const std::vector<int> nodes = {0, 0, 0, 0, 1, 1, 2, 2, 1, 1};
+  const std::vector<double> p = {1.0, 1.0, 1.0, 1.0, 0.95, 0.95, 0.9, 0.9, 0.8, 0.8};
+  const LoopClosureTruth truth = truthFromRooms(rooms, 0);
+  // Room 0: {0,1} x {6,7}; room 2: {4,5} x {8,9}; room 1 is visited once.
+  CHECK(truth.positives() == 8);
+  // Inside P0, (2,0) crosses the room change: a true negative of the truth (different rooms and visits).
+  CHECK(truth.at(2, 0) == 0);
+  const auto pairs = pairsFromAssignments(nodes, p);
+  // Only the revisit of node 1 claims a loop closure: (8,4), (8,5), (9,4), (9,5). Counting the pairs inside
+  // P0 as predictions (the old reading) would add (2,0), (2,1), (3,0), (3,1) as false positives at score 1.0
+  // and pin recall at 100 % precision to 0.
+  REQUIRE(pairs.size() == 4);
+  for (const ScoredPair& pair : pairs) {
+    CHECK(nodes[static_cast<std::size_t>(pair.i)] == 1);
+    CHECK(pair.i >= 8);
+    CHECK(pair.j <= 5);
+    CHECK(pair.score == Approx(0.8));
+  }
+  const PrCurve curve = precisionRecall(truth, pairs);
+  CHECK(curve.predicted == 4);
+  REQUIRE(curve.points.size() == 1);
+  CHECK(curve.points[0].true_positives == 4);
+  CHECK(curve.points[0].false_positives == 0);
+  CHECK(curve.recall_at_full_precision == Approx(0.5));
+  CHECK(curve.threshold_at_full_precision == Approx(0.8));
+  CHECK(curve.average_precision == Approx(0.5));
 }
 
 SCENARIO(

@@ -85,7 +85,7 @@ SCENARIO("GIVEN malformed run files WHEN loaded THEN the error names the file an
                     Contains("labels2.csv:3: frame 2 out of order, expected 1"));
   writeText(dir / "places.csv", "place,first,last,representative\n0,5,3,4\n");
   CHECK_THROWS_WITH(loadPlaces((dir / "places.csv").string()),
-                    Contains("places.csv:2: need first <= representative <= last"));
+                    Contains("places.csv:2: need 0 <= first <= representative <= last"));
   writeText(dir / "topology.json", "{\"nodes\": []}");
   CHECK_THROWS_WITH(loadTopology((dir / "topology.json").string()),
                     Contains("topology.json: missing key 'probability'"));

@@ -1,8 +1,11 @@
 // Tests of floor plans: YAML parsing and its error messages, the built-in worlds, the decoration.
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
+#include <string>
 
 #include "toposlam/sim/floor_plan.hpp"
 #include "toposlam/sim/simulator.hpp"
@@ -10,6 +13,23 @@
 using namespace toposlam::sim;
 
 namespace {
+
+/// A fresh folder of its own under the system temp dir (mkdtemp: parallel test runs never share it),
+/// removed with everything in it when the test ends.
+struct UniqueTempFolder {
+  std::filesystem::path path;
+  UniqueTempFolder() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "toposlam-floor-plan-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed for " + pattern);
+    path = pattern;
+  }
+  ~UniqueTempFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+  UniqueTempFolder(const UniqueTempFolder&) = delete;
+  UniqueTempFolder& operator=(const UniqueTempFolder&) = delete;
+};
 
 const char* const kTwoRooms = R"(
 name: flat
@@ -56,7 +76,8 @@ TEST_CASE("GIVEN a YAML floor plan WHEN it is parsed THEN rooms, doors and the l
   CHECK(world.placeLabel({4.5, 1.5}) == 1);
 
   // It renders through the same path as the built-in worlds, from a file.
-  const auto path = std::filesystem::temp_directory_path() / "toposlam_test_flat.yaml";
+  const UniqueTempFolder folder;
+  const auto path = folder.path / "flat.yaml";
   std::ofstream(path) << kTwoRooms;
   SimConfig config;
   config.world = path.string();
@@ -66,7 +87,6 @@ TEST_CASE("GIVEN a YAML floor plan WHEN it is parsed THEN rooms, doors and the l
   const Simulator simulator(config);
   CHECK(simulator.frameCount() > 5);
   CHECK(simulator.render(0).image.size() == cv::Size(96, 72));
-  std::filesystem::remove(path);
 }
 
 TEST_CASE("GIVEN malformed floor plans WHEN parsed THEN the message names the offending key", "[sim]") {

@@ -32,7 +32,8 @@ struct RunData {
   std::vector<std::int64_t> traversal_starts;
 };
 
-/// Throws RunFileError naming the file when the folder or frames.csv is missing or a file is malformed.
+/// Throws RunFileError naming the file (and line) when the folder or frames.csv is missing, a file is
+/// malformed, or a place lies outside frames.csv (a damaged run folder).
 RunData loadRun(const std::string& dir);
 /// `count` traversals of equal length (count >= 1).
 std::vector<std::int64_t> splitTraversals(std::int64_t frame_count, int count);
@@ -44,12 +45,13 @@ struct Truth {
   std::vector<LabelRow> labels;
   LoopClosureMatrix matrix;
   std::vector<NamedPair> pairs;
-  /// Labels only: first frame of each labels file when several were concatenated (one per traversal).
-  std::vector<std::int64_t> file_starts;
+  /// Labels only: first frame of each traversal, from the labels' `traversal` column and one per labels file
+  /// when several were concatenated; empty when the labels do not say (old labels.csv, one file).
+  std::vector<std::int64_t> traversal_starts;
 };
 
 /// By content: a CSV whose header has `room` is labels.csv, any other CSV is a pairs file, anything else
-/// is read as a matrix image.
+/// is read as a matrix image. Labels with a `traversal` column set traversal_starts.
 Truth loadTruth(const std::string& path);
 /// Several truth files: labels files are concatenated in order (their first frames become the traversal
 /// starts); a matrix or pairs file must come alone. Throws std::invalid_argument otherwise.
@@ -60,8 +62,9 @@ struct EvalOptions {
   int min_gap = -1;   ///< loop closures: pairs closer than this are ignored; -1 = auto
                       ///< (25, the segmentation window, for a matrix/pairs; 0 for labels)
   std::vector<double> thresholds = defaultThresholds();
-  int traversals = 0;  ///< > 0: split the frames evenly into this many traversals; 0: one per labels file
-                       ///< when several were given, else one per source of `map` (time going back)
+  /// > 0: split the frames evenly into this many traversals when the labels do not say (no `traversal`
+  /// column, one labels file); 0: one per source of `map` (time going back). Labels that say win.
+  int traversals = 0;
 };
 
 struct EvalResult {

@@ -63,8 +63,14 @@ struct ScoredPair {
   double score = 0.0;
 };
 
-/// Predicted loop closures from frame -> node assignments: every pair of frames whose nodes are equal
-/// (and >= 0) with score = the later frame's node probability.
+/// Visit number per frame of a label sequence (rooms or nodes): a visit is a maximal run of one label
+/// >= 0, frames labelled -1 ignored in between (they get -1 and neither end nor start a visit).
+std::vector<int> visitIds(const std::vector<int>& labels);
+
+/// Predicted loop closures from frame -> node assignments: every pair of frames on the same node (>= 0)
+/// in different visits of it (visitIds of node_of_frame), score = the later frame's node probability.
+/// Pairs within one visit (one place, or consecutive places kept on one node) are no loop closure: the
+/// robot never left, so nothing was recognised.
 std::vector<ScoredPair> pairsFromAssignments(const std::vector<int>& node_of_frame,
                                              const std::vector<double>& probability_of_frame);
 

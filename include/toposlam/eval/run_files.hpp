@@ -26,6 +26,9 @@ struct LabelRow {
   std::int64_t frame = 0;
   double time_s = 0.0;
   int room = -1;  ///< >= 0 a room; -1 "in a doorway" (no room)
+  /// Which traversal of the route the frame is on (optional column `traversal`, written by `toposlam sim`):
+  /// >= 0 and never decreasing down the file; -1 when the file has no such column.
+  int traversal = -1;
 };
 
 /// One row of frames.csv.
@@ -41,6 +44,7 @@ struct FrameRecord {
 /// One row of places.csv / dropped_places.csv.
 struct PlaceRecord {
   int place = 0;
+  int line = 0;  ///< line of places.csv / dropped_places.csv, for error messages
   std::int64_t first = 0, last = 0, representative = 0;
   int keypoints = 0;
   int node = -1;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "eval_cli_options.hpp"
 #include "toposlam/eval/evaluation.hpp"
 
 namespace toposlam::cli {
@@ -44,6 +45,26 @@ void runEval(const EvalCommandOptions& o) {
 
 }  // namespace
 
+void addEvalMeasureOptions(CLI::App& cmd, eval::EvalOptions& options) {
+  cmd.add_option("--tolerance", options.tolerance, "Frames a place cut may be off a room change")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd.add_option("--min-gap", options.min_gap,
+                 "Loop closures: ignore frame pairs at most this many frames apart (-1 = 25 for a matrix or "
+                 "pairs file, 0 for labels)")
+      ->check(CLI::Range(-1, 100000))
+      ->capture_default_str();
+  cmd.add_option(
+         "--traversals", options.traversals,
+         "Split the frames evenly into N traversals when the labels do not say (no traversal column); "
+         "0 = one per labels file, or per source of `map`")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  cmd.add_option("--thresholds", options.thresholds, "Probability thresholds of the localisation table")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+}
+
 void addEvalCommand(CLI::App& app) {
   auto options = std::make_shared<EvalCommandOptions>();
   auto* cmd =
@@ -55,22 +76,7 @@ void addEvalCommand(CLI::App& app) {
          "labels.csv (frame,room; several = one per traversal, in order), a loop-closure matrix image "
          "(like samples_GT.bmp) or a pairs CSV (like samples_GT_pairs.csv)")
       ->required();
-  cmd->add_option("--tolerance", options->eval.tolerance, "Frames a place cut may be off a room change")
-      ->check(CLI::Range(0, 100000))
-      ->capture_default_str();
-  cmd->add_option("--min-gap", options->eval.min_gap,
-                  "Loop closures: ignore frame pairs at most this many frames apart (-1 = 25 for a matrix or "
-                  "pairs file, 0 for labels)")
-      ->check(CLI::Range(-1, 100000))
-      ->capture_default_str();
-  cmd->add_option(
-         "--traversals", options->eval.traversals,
-         "Split the frames evenly into N traversals (0 = one per labels file, or per source of `map`)")
-      ->check(CLI::Range(0, 1000))
-      ->capture_default_str();
-  cmd->add_option("--thresholds", options->eval.thresholds,
-                  "Probability thresholds of the localisation table")
-      ->capture_default_str();
+  addEvalMeasureOptions(*cmd, options->eval);
   cmd->add_flag("--json", options->json, "Print eval.json instead of the tables");
   cmd->callback([options] { runEval(*options); });
 }

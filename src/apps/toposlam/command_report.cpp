@@ -2,7 +2,8 @@
 // page for a run folder (see include/toposlam/eval/report.hpp for the figures). Thumbnails come from the
 // run's frames: `--frames DIR` (one per traversal, in order), else RUN_DIR/frames/, else the folders
 // listed in RUN_DIR/source.txt (one source URI per line; `images:DIR` or a plain folder). A frame is
-// found by its frames.csv `name` in its traversal's folder, else by its position in that folder.
+// found by its frames.csv `name` in its source's folder, or by its position there when that folder holds
+// none of the run's names (see thumbnailPaths).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
+#include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"
 
@@ -74,6 +76,45 @@ std::vector<std::string> imageFiles(const fs::path& folder) {
   return names;
 }
 
+/// The image file of each of `frames` (empty path = not found). Frames are looked up per source of the run
+/// (time going back), one folder each: by their frames.csv name when the source's folder holds the run's
+/// names at all, else by position in the folder (sources without file names, e.g. sim: or video:). A named
+/// frame missing from a folder that holds the others stays missing rather than being replaced by its
+/// neighbour in the listing.
+std::vector<fs::path> thumbnailPaths(const eval::RunData& run, const std::vector<std::int64_t>& frames,
+                                     const std::vector<fs::path>& folders) {
+  const std::vector<std::int64_t>& starts = run.traversal_starts;
+  auto sourceOf = [&](std::int64_t f) { return static_cast<std::size_t>(eval::traversalOf(f, starts)); };
+  auto nameOf = [&](std::int64_t f) -> const std::string& {
+    return run.frames[static_cast<std::size_t>(f)].name;
+  };
+  std::vector<bool> by_name(folders.size(), false);
+  for (std::int64_t f : frames) {
+    const std::size_t source = sourceOf(f);
+    if (source < folders.size() && !by_name[source] && !nameOf(f).empty() &&
+        fs::exists(folders[source] / nameOf(f))) {
+      by_name[source] = true;
+    }
+  }
+  std::vector<std::vector<std::string>> listings(folders.size());
+  std::vector<fs::path> paths;
+  for (std::int64_t f : frames) {
+    const std::size_t source = sourceOf(f);
+    fs::path path;
+    if (source >= folders.size()) {
+      // more sources than frame folders: nothing to show
+    } else if (by_name[source]) {
+      if (!nameOf(f).empty() && fs::exists(folders[source] / nameOf(f))) path = folders[source] / nameOf(f);
+    } else {
+      if (listings[source].empty()) listings[source] = imageFiles(folders[source]);
+      const auto index = static_cast<std::size_t>(f - starts[source]);
+      if (index < listings[source].size()) path = folders[source] / listings[source][index];
+    }
+    paths.push_back(path);
+  }
+  return paths;
+}
+
 std::string thumbnailDataUri(const fs::path& path) {
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
   if (image.empty()) return "";
@@ -107,25 +148,13 @@ void runReport(const ReportCommandOptions& o) {
         "no frames found (no --frames DIR, RUN_DIR/frames or RUN_DIR/source.txt): figures without "
         "thumbnails");
   } else {
-    // Frames are looked up per source of the run (time going back), one folder each.
-    const std::vector<std::int64_t>& source_starts = in.run.traversal_starts;
-    std::vector<std::vector<std::string>> listings(folders.size());
+    const std::vector<std::int64_t> frames = eval::framesForThumbnails(in.run, o.thumbnails);
+    const std::vector<fs::path> paths = thumbnailPaths(in.run, frames, folders);
     int missing = 0;
-    for (std::int64_t f : eval::framesForThumbnails(in.run, o.thumbnails)) {
-      const int source = eval::traversalOf(f, source_starts);
-      const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(source), folders.size() - 1);
-      const std::string& name = in.run.frames[static_cast<std::size_t>(f)].name;
-      fs::path path = folders[k] / name;
-      if (name.empty() || !fs::exists(path)) {
-        if (listings[k].empty()) listings[k] = imageFiles(folders[k]);
-        const auto index =
-            static_cast<std::size_t>(f - source_starts[static_cast<std::size_t>(std::min<std::size_t>(
-                                             static_cast<std::size_t>(source), source_starts.size() - 1))]);
-        path = index < listings[k].size() ? folders[k] / listings[k][index] : fs::path();
-      }
-      std::string uri = path.empty() ? "" : thumbnailDataUri(path);
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      std::string uri = paths[k].empty() ? "" : thumbnailDataUri(paths[k]);
       if (uri.empty()) ++missing;
-      in.thumbnails[static_cast<std::size_t>(f)] = std::move(uri);
+      in.thumbnails[static_cast<std::size_t>(frames[k])] = std::move(uri);
     }
     if (missing > 0)
       in.warnings.push_back(std::to_string(missing) + " frames could not be read for thumbnails");
@@ -169,9 +198,7 @@ void addReportCommand(CLI::App& app) {
   cmd->add_option("--thumbnails", options->thumbnails, "About this many evenly spaced frame thumbnails")
       ->check(CLI::Range(0, 2000))
       ->capture_default_str();
-  cmd->add_option("--tolerance", options->eval.tolerance, "As for `toposlam eval`")->capture_default_str();
-  cmd->add_option("--min-gap", options->eval.min_gap, "As for `toposlam eval`")->capture_default_str();
-  cmd->add_option("--traversals", options->eval.traversals, "As for `toposlam eval`")->capture_default_str();
+  addEvalMeasureOptions(*cmd, options->eval);
   cmd->callback([options] { runReport(*options); });
 }
 

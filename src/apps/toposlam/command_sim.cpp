@@ -1,8 +1,7 @@
 // `toposlam sim WORLD --route R --out DIR`: renders a route through a simulated world and writes the
-// frames (frames/000000.png ...), the ground truth (labels.csv: frame,time,room,x,y,heading), the
+// frames (frames/000000.png ...), the ground truth (labels.csv: frame,time,room,x,y,heading,traversal), the
 // loop-closure matrix of the labels (loop_closure.png, laid out like samples_GT.bmp) and a top-down map
-// of the world with the route (map.png). `--bench` renders without writing and prints frames per second.
-#include <chrono>
+// of the world with the route (map.png). Rendering speed is measured by `toposlam bench sim`.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -37,7 +36,6 @@ struct SimOptions {
   double pitch = 0.0;
   bool moved = false;
   int progress_every = 200;
-  bool bench = false;
 };
 
 sim::SimConfig toConfig(const SimOptions& options) {
@@ -62,25 +60,9 @@ sim::SimConfig toConfig(const SimOptions& options) {
   return config;
 }
 
-void runBench(const sim::Simulator& simulator) {
-  const std::int64_t frames = simulator.frameCount();
-  const auto start = std::chrono::steady_clock::now();
-  std::uint64_t checksum = 0;
-  for (std::int64_t i = 0; i < frames; ++i) checksum += simulator.render(i).image.at<cv::Vec3b>(0, 0)[0];
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("sim %s route %s %dx%d: %lld frames in %.3f s = %.1f frames/s on one core (checksum %llu)\n",
-              simulator.config().world.c_str(), simulator.config().route.c_str(), simulator.config().camera.width,
-              simulator.config().camera.height, static_cast<long long>(frames), seconds, frames / seconds,
-              static_cast<unsigned long long>(checksum));
-}
-
 void runSim(const SimOptions& options) {
   const sim::SimConfig config = toConfig(options);
   const sim::Simulator simulator(config);
-  if (options.bench) {
-    runBench(simulator);
-    return;
-  }
   if (options.out.empty()) throw std::invalid_argument("--out: give the folder to write frames and labels.csv into");
   namespace fs = std::filesystem;
   const fs::path out(options.out);
@@ -89,7 +71,7 @@ void runSim(const SimOptions& options) {
   if (error) throw std::runtime_error("--out: cannot create '" + (out / "frames").string() + "': " + error.message());
   std::ofstream labels(out / "labels.csv");
   if (!labels) throw std::runtime_error("--out: cannot write '" + (out / "labels.csv").string() + "'");
-  labels << "frame,time,room,x,y,heading\n";
+  labels << "frame,time,room,x,y,heading,traversal\n";
   std::vector<sim::Pose> poses;
   std::vector<int> traversals, rooms;
   const std::int64_t frames = simulator.frameCount();
@@ -102,9 +84,10 @@ void runSim(const SimOptions& options) {
     if (!cv::imwrite((out / "frames" / name).string(), frame.image)) {
       throw std::runtime_error("--out: cannot write frame " + (out / "frames" / name).string());
     }
-    char row[160];
-    std::snprintf(row, sizeof row, "%lld,%.4f,%d,%.4f,%.4f,%.5f\n", static_cast<long long>(i), frame.truth.time_s,
-                  frame.truth.room, frame.truth.pose.x, frame.truth.pose.y, frame.truth.pose.heading);
+    char row[192];
+    std::snprintf(row, sizeof row, "%lld,%.4f,%d,%.4f,%.4f,%.5f,%d\n", static_cast<long long>(i),
+                  frame.truth.time_s, frame.truth.room, frame.truth.pose.x, frame.truth.pose.y,
+                  frame.truth.pose.heading, frame.truth.traversal);
     labels << row;
     poses.push_back(frame.truth.pose);
     traversals.push_back(frame.truth.traversal);
@@ -145,7 +128,6 @@ void addSimCommand(CLI::App& app) {
   cmd->add_flag("--moved", options->moved, "Move the furniture between traversals");
   cmd->add_option("--progress", options->progress_every, "Print a progress line every N frames (0 = never)")
       ->capture_default_str();
-  cmd->add_flag("--bench", options->bench, "Render without writing and print frames per second");
   cmd->callback([options] { runSim(*options); });
 }
 
