@@ -8,7 +8,7 @@
 #      increasing sequence numbers and monotonic timestamps;
 #   3. toposlamd on the loopback device, publishing over LCM on lo, checked by a subscriber (a missing
 #      toposlamd binary is a failure, not a skip).
-# Prints "VMTEST PASS|FAIL|SKIP <what>" lines for tests/vm/run-vm-test.sh, then "VMTEST DONE failures=N".
+# Prints "VMTEST PASS|FAIL <what>" lines for tests/vm/run-vm-test.sh, then "VMTEST DONE failures=N".
 # Usage (from the initramfs init): guest.sh BUILD_DIR
 build=${1:?usage: guest.sh BUILD_DIR}
 toposlam=$build/src/apps/toposlam/toposlam
