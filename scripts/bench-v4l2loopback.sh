@@ -74,10 +74,18 @@ fi
 "$toposlam" listen --channels TOPOSLAM_STATUS --timeout $((seconds + 10)) >/tmp/toposlam-bench-status.txt 2>&1 &
 pids+=($!)
 set +e
-timeout -s TERM "$seconds" "$toposlamd" --source "$uri" --map /tmp/toposlam-bench-map.tsm --no-map-load \
-  >/tmp/toposlam-bench-daemon.txt 2>&1
+# --preserve-status: toposlamd's own exit code after the SIGTERM (0 = clean stop, map saved); -k: killed
+# 20 s later if it does not stop (137).
+timeout --preserve-status -k 20 -s TERM "$seconds" "$toposlamd" --source "$uri" --map /tmp/toposlam-bench-map.tsm \
+  --no-map-load >/tmp/toposlam-bench-daemon.txt 2>&1
+daemon_rc=$?
 set -e
 sleep 1
 echo "bench: last daemon status (fps, capture-to-publish latency, drops):"
 grep '^STATUS' /tmp/toposlam-bench-status.txt | tail -1 || echo "  (no TOPOSLAM_STATUS received; see /tmp/toposlam-bench-daemon.txt)"
 echo "bench: capture summary: $(grep '^summary' /tmp/toposlam-bench-capture.txt)"
+if [ "$daemon_rc" -ne 0 ]; then
+  echo "bench-v4l2loopback: toposlamd exited with $daemon_rc after SIGTERM (expected 0); last lines of its log:" >&2
+  tail -5 /tmp/toposlam-bench-daemon.txt >&2
+  exit 1
+fi

@@ -123,7 +123,7 @@ std::string ImageFilesSource::describe() const {
 }
 
 std::optional<Frame> ImageFilesSource::next() {
-  while (next_index_ < files_.size()) {
+  while (next_index_ < files_.size() && !interrupted_.load()) {
     const std::size_t index = next_index_++;
     const std::string& file = files_[index];
     std::ifstream in(file, std::ios::binary);
@@ -166,6 +166,7 @@ std::string VideoFileSource::describe() const {
 }
 
 std::optional<Frame> VideoFileSource::next() {
+  if (interrupted_.load()) return std::nullopt;
   cv::Mat image;
   if (!capture_.read(image) || image.empty()) return std::nullopt;
   Frame frame;

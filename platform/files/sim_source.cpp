@@ -45,6 +45,7 @@ std::string SimFrameSource::describe() const {
 }
 
 std::optional<Frame> SimFrameSource::next() {
+  if (interrupted_.load()) return std::nullopt;
   std::optional<sim::SimFrame> rendered = simulator_->next();
   if (!rendered) return std::nullopt;
   last_truth_ = rendered->truth;

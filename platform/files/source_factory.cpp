@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
-#include <thread>
+#include <condition_variable>
 
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/sim_source.hpp"
@@ -21,6 +21,7 @@ struct SchemeEntry {
   std::string usage;
 };
 
+// Holds the next frame until it is due; the wait is bounded (nextFor) and ends early on interrupt().
 class RateLimitedSource : public FrameSource {
  public:
   RateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz) : inner_(std::move(inner)), rate_hz_(rate_hz) {}
@@ -28,16 +29,45 @@ class RateLimitedSource : public FrameSource {
     return inner_->describe() + " at " + std::to_string(rate_hz_) + " Hz real time";
   }
   std::optional<Frame> next() override {
-    std::optional<Frame> frame = inner_->next();
-    if (!frame) return frame;
-    const auto now = std::chrono::steady_clock::now();
-    if (delivered_ == 0) start_ = now;
-    const auto due = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                  std::chrono::duration<double>(static_cast<double>(delivered_) / rate_hz_));
-    if (due > now) std::this_thread::sleep_until(due);
-    ++delivered_;
-    return frame;
+    for (;;) {
+      Frame frame;
+      const SourceWait wait = nextFor(std::chrono::hours(1), frame);
+      if (wait == SourceWait::Frame) return frame;
+      if (wait == SourceWait::End) return std::nullopt;
+    }
   }
+  SourceWait nextFor(std::chrono::milliseconds timeout, Frame& out) override {
+    if (!pending_) {
+      Frame frame;
+      const SourceWait wait = inner_->nextFor(timeout, frame);
+      if (wait != SourceWait::Frame) return wait;
+      const auto now = std::chrono::steady_clock::now();
+      if (delivered_ == 0) start_ = now;
+      due_ = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                          std::chrono::duration<double>(static_cast<double>(delivered_) / rate_hz_));
+      pending_ = std::move(frame);
+    }
+    {
+      std::unique_lock lock(mutex_);
+      const auto until = std::min(due_, std::chrono::steady_clock::now() + timeout);
+      woken_.wait_until(lock, until, [this] { return interrupted_; });
+      if (interrupted_) return SourceWait::End;
+    }
+    if (std::chrono::steady_clock::now() < due_) return SourceWait::Timeout;
+    ++delivered_;
+    out = std::move(*pending_);
+    pending_.reset();
+    return SourceWait::Frame;
+  }
+  void interrupt() override {
+    {
+      std::lock_guard lock(mutex_);
+      interrupted_ = true;
+    }
+    woken_.notify_all();
+    inner_->interrupt();
+  }
+  FrameSourceState state() const override { return inner_->state(); }
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
 
@@ -45,7 +75,12 @@ class RateLimitedSource : public FrameSource {
   std::unique_ptr<FrameSource> inner_;
   double rate_hz_;
   std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point due_;
+  std::optional<Frame> pending_;  ///< taken from the inner source, not yet due
   std::int64_t delivered_ = 0;
+  std::mutex mutex_;
+  std::condition_variable woken_;
+  bool interrupted_ = false;
 };
 
 std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {

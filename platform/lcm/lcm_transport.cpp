@@ -168,6 +168,10 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.frames_published = s.frames_published;
   msg.frames_dropped = s.frames_dropped;
   msg.source_skipped = s.source_skipped;
+  msg.source_state = toString(s.source_link);
+  msg.source_reconnects = s.source_reconnects;
+  msg.source_reconnect_attempts = s.source_reconnect_attempts;
+  msg.source_dropped = s.source_dropped;
   msg.latency_median_ms = asFloat(s.latency.median_ms);
   msg.latency_p99_ms = asFloat(s.latency.p99_ms);
   msg.latency_max_ms = asFloat(s.latency.max_ms);
@@ -323,7 +327,9 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);
       w.field("frames_captured", m.frames_captured).field("frames_published", m.frames_published)
-          .field("frames_dropped", m.frames_dropped);
+          .field("frames_dropped", m.frames_dropped).field("source_state", m.source_state)
+          .field("source_reconnects", m.source_reconnects).field("source_reconnect_attempts", m.source_reconnect_attempts)
+          .field("source_dropped", m.source_dropped);
       jsonNumber(w, "latency_median_ms", m.latency_median_ms);
       jsonNumber(w, "latency_p99_ms", m.latency_p99_ms);
       jsonNumber(w, "latency_max_ms", m.latency_max_ms);
@@ -340,11 +346,15 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
         w.endObject();
       }
       w.endArray();
-      char line[200];
-      std::snprintf(line, sizeof line, "STATUS %s  %.1f fps  latency median %.1f / p99 %.1f ms  %lld published  %lld dropped  cpu %.0f%%",
+      char line[320];
+      std::snprintf(line, sizeof line,
+                    "STATUS %s  %.1f fps  latency median %.1f / p99 %.1f ms  %lld published  %lld dropped  cpu %.0f%%  "
+                    "camera %s (%lld reconnects, %lld lost by the driver)",
                     m.state.c_str(), static_cast<double>(m.fps), static_cast<double>(m.latency_median_ms),
                     static_cast<double>(m.latency_p99_ms), static_cast<long long>(m.frames_published),
-                    static_cast<long long>(m.frames_dropped), static_cast<double>(m.cpu_percent));
+                    static_cast<long long>(m.frames_dropped), static_cast<double>(m.cpu_percent),
+                    m.source_state.c_str(), static_cast<long long>(m.source_reconnects),
+                    static_cast<long long>(m.source_dropped));
       out.summary = line;
     }
   } else {

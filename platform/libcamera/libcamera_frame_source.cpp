@@ -158,6 +158,8 @@ struct LibcameraFrameSource::Impl : std::enable_shared_from_this<Impl> {
   std::int64_t dropped = 0;
   std::int64_t skipped = 0;
   std::int64_t delivered = 0;
+  /// When the last frame (or the start) was, for the no-frame timeout; touched by next() only.
+  std::chrono::steady_clock::time_point last_frame_at = std::chrono::steady_clock::now();
 
   /// Stops capturing; mappings stay until the last lease is gone. Idempotent.
   void stopCamera() {
@@ -287,7 +289,7 @@ LibcameraFrameSource::LibcameraFrameSource(LibcameraSourceConfig config) : impl_
 
 LibcameraFrameSource::~LibcameraFrameSource() {
   if (impl_->camera) impl_->stopCamera();  // leases may keep the mappings (and Impl) a little longer
-  requestStop();
+  interrupt();
 }
 
 std::string LibcameraFrameSource::describe() const {
@@ -307,7 +309,14 @@ std::int64_t LibcameraFrameSource::droppedFrames() const {
   return impl_->dropped;
 }
 
-void LibcameraFrameSource::requestStop() {
+FrameSourceState LibcameraFrameSource::state() const {
+  std::lock_guard lock(impl_->mutex);
+  FrameSourceState state;
+  state.dropped = impl_->dropped;  // libcamera has no reconnecting: a lost camera ends with an error
+  return state;
+}
+
+void LibcameraFrameSource::interrupt() {
   {
     std::lock_guard lock(impl_->mutex);
     impl_->stop_requested = true;
@@ -316,18 +325,30 @@ void LibcameraFrameSource::requestStop() {
 }
 
 std::optional<Frame> LibcameraFrameSource::next() {
-  Impl& impl = *impl_;
   for (;;) {
+    Frame frame;
+    const SourceWait wait = nextFor(std::chrono::milliseconds(impl_->config.timeout_ms), frame);
+    if (wait == SourceWait::Frame) return frame;
+    if (wait == SourceWait::End) return std::nullopt;
+  }
+}
+
+SourceWait LibcameraFrameSource::nextFor(std::chrono::milliseconds timeout, Frame& out) {
+  Impl& impl = *impl_;
+  {
     libcamera::Request* request = nullptr;
     {
       std::unique_lock lock(impl.mutex);
-      const bool woke =
-          impl.completed_cv.wait_for(lock, std::chrono::milliseconds(impl.config.timeout_ms),
-                                     [&] { return impl.stop_requested || !impl.completed.empty(); });
-      if (impl.stop_requested) return std::nullopt;
-      if (!woke)
+      const auto give_up_at = impl.last_frame_at + std::chrono::milliseconds(impl.config.timeout_ms);
+      const auto wait_until = std::min(give_up_at, std::chrono::steady_clock::now() + timeout);
+      const bool woke = impl.completed_cv.wait_until(
+          lock, wait_until, [&] { return impl.stop_requested || !impl.completed.empty(); });
+      if (impl.stop_requested) return SourceWait::End;
+      if (!woke) {
+        if (std::chrono::steady_clock::now() < give_up_at) return SourceWait::Timeout;
         throw FrameSourceError("libcamera:" + impl.camera->id() + ": no frame for " +
                                std::to_string(impl.config.timeout_ms) + " ms");
+      }
       request = impl.completed.front();
       impl.completed.pop_front();
     }
@@ -337,7 +358,7 @@ std::optional<Frame> LibcameraFrameSource::next() {
       std::lock_guard lock(impl.mutex);
       ++impl.skipped;
       impl.requeueLocked(request);
-      continue;
+      return SourceWait::Timeout;  // skipped (counted)
     }
     const Mapping& mapping = impl.mappings.at(buffer);
     const std::size_t used = metadata.planes()[0].bytesused;
@@ -369,14 +390,16 @@ std::optional<Frame> LibcameraFrameSource::next() {
       if (frame.image.empty()) {
         std::lock_guard lock(impl.mutex);
         ++impl.skipped;
-        continue;
+        return SourceWait::Timeout;  // skipped (counted)
       }
     }
     {
       std::lock_guard lock(impl.mutex);
       ++impl.delivered;
     }
-    return frame;
+    impl.last_frame_at = std::chrono::steady_clock::now();
+    out = std::move(frame);
+    return SourceWait::Frame;
   }
 }
 

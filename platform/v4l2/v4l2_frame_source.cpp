@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -132,13 +133,13 @@ std::string V4l2SourceConfig::validate() const {
   return "";
 }
 
-V4l2SourceConfig parseV4l2Uri(const std::string& uri) {
+V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults) {
   const std::string scheme = "v4l2:";
   if (uri.rfind(scheme, 0) != 0)
     throw FrameSourceError("v4l2: URI must start with 'v4l2:', got '" + uri + "'");
   const std::string rest = uri.substr(scheme.size());
   const auto question = rest.find('?');
-  V4l2SourceConfig config;
+  V4l2SourceConfig config = defaults;
   config.device = rest.substr(0, question);
   if (config.device.empty() || config.device.front() != '/')
     throw FrameSourceError("v4l2: expected a device path like v4l2:/dev/video0, got '" + uri + "'");
@@ -180,10 +181,16 @@ V4l2SourceConfig parseV4l2Uri(const std::string& uri) {
                                  ", got '" + value + "'");
       } else if (key == "buffers") {
         config.buffer_count = parseInt("buffers", value, "4");
+      } else if (key == "wait") {
+        if (value != "0" && value != "1")
+          throw FrameSourceError("v4l2: wait: expected 0 (fail if the camera is missing at start) or 1 "
+                                 "(wait for it), got '" + value + "'");
+        config.wait_at_start = value == "1";
       } else if (key == "rate") {
         // The factory's common real-time key (openFrameSource wraps the source); a camera is real time.
       } else {
-        throw FrameSourceError("v4l2: unknown parameter '" + key + "' (allowed: size, fps, format, buffers)");
+        throw FrameSourceError("v4l2: unknown parameter '" + key +
+                               "' (allowed: size, fps, format, buffers, wait)");
       }
     }
   }
@@ -247,7 +254,15 @@ V4l2FrameSource::V4l2FrameSource(V4l2SourceConfig config, std::unique_ptr<V4l2De
       return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
     };
   }
-  start();
+  if (!start(config_.wait_at_start)) {
+    spdlog::warn("v4l2:{}: no such device yet; waiting for the camera (reconnecting with backoff)",
+                 config_.device);
+    updateStatus([&](V4l2SourceStatus& s) {
+      s.connected = false;
+      s.reconnecting = true;
+      s.last_error = "no such device at start";
+    });
+  }
 }
 
 V4l2FrameSource::~V4l2FrameSource() { stop(); }
@@ -273,6 +288,16 @@ std::string V4l2FrameSource::describe() const {
 }
 
 std::int64_t V4l2FrameSource::skippedFrames() const { return status().skipped; }
+
+FrameSourceState V4l2FrameSource::state() const {
+  std::lock_guard lock(status_mutex_);
+  FrameSourceState state;
+  state.link = status_.reconnecting ? SourceLink::Reconnecting : SourceLink::Streaming;
+  state.reconnects = status_.reconnects;
+  state.reconnect_attempts = status_.reconnect_attempts;
+  state.dropped = status_.dropped;
+  return state;
+}
 std::int64_t V4l2FrameSource::droppedFrames() const { return status().dropped; }
 
 V4l2SourceStatus V4l2FrameSource::status() const {
@@ -280,12 +305,13 @@ V4l2SourceStatus V4l2FrameSource::status() const {
   return status_;
 }
 
-void V4l2FrameSource::requestStop() {
+void V4l2FrameSource::interrupt() {
   {
     std::lock_guard lock(stop_mutex_);
     stop_requested_ = true;
   }
-  stop_cv_.notify_all();  // a waiting next() on returned buffers notices within poll_timeout_ms
+  // Wakes a backoff wait; a poll slice or a wait for a lent-out buffer notices within poll_timeout_ms.
+  stop_cv_.notify_all();
 }
 
 void V4l2FrameSource::waitFor(std::chrono::milliseconds delay) {
@@ -297,7 +323,7 @@ void V4l2FrameSource::waitFor(std::chrono::milliseconds delay) {
   stop_cv_.wait_for(lock, delay, [this] { return stop_requested_.load(); });
 }
 
-void V4l2FrameSource::start() {
+bool V4l2FrameSource::start(bool absent_is_ok) {
   const std::string where = "v4l2:" + config_.device;
   auto stream = std::make_shared<Stream>();
   stream->device = device_;
@@ -308,6 +334,7 @@ void V4l2FrameSource::start() {
   };
 
   if (const int opened = device_->open(config_.device); opened < 0) {
+    if (absent_is_ok && (opened == -ENOENT || opened == -ENODEV || opened == -ENXIO)) return false;
     std::string hint;
     if (opened == -ENOENT) hint = "; is the camera plugged in (ls /dev/video*)?";
     if (opened == -EACCES) hint = "; add the user to the 'video' group";
@@ -450,6 +477,7 @@ void V4l2FrameSource::start() {
     s.fps = fps;
     s.driver = driver;
   });
+  return true;
 }
 
 void V4l2FrameSource::stop() {
@@ -478,29 +506,37 @@ void V4l2FrameSource::lose(const std::string& reason) {
   });
 }
 
-bool V4l2FrameSource::reconnectStep() {
+void V4l2FrameSource::reconnectSlice(std::chrono::milliseconds timeout) {
   int attempt = 0;
-  updateStatus([&](V4l2SourceStatus& s) { attempt = ++s.reconnect_attempts; });
-  std::int64_t delay_ms = config_.reconnect_initial_ms;
-  for (int i = 1; i < attempt && delay_ms < config_.reconnect_max_ms; ++i) delay_ms *= 2;
-  delay_ms = std::min<std::int64_t>(delay_ms, config_.reconnect_max_ms);
-  waitFor(std::chrono::milliseconds(delay_ms));
-  if (stop_requested_) return false;
+  updateStatus([&](V4l2SourceStatus& s) {
+    if (backoff_left_ms_ < 0) ++s.reconnect_attempts;  // a new attempt is scheduled
+    attempt = s.reconnect_attempts;
+  });
+  if (backoff_left_ms_ < 0) {
+    std::int64_t delay_ms = config_.reconnect_initial_ms;
+    for (int i = 1; i < attempt && delay_ms < config_.reconnect_max_ms; ++i) delay_ms *= 2;
+    backoff_left_ms_ = std::min<std::int64_t>(delay_ms, config_.reconnect_max_ms);
+  }
+  // One slice of the backoff per call, so a real-time caller gets control back within its timeout.
+  const std::int64_t slice_ms = std::min<std::int64_t>(backoff_left_ms_, std::max<std::int64_t>(1, timeout.count()));
+  waitFor(std::chrono::milliseconds(slice_ms));
+  backoff_left_ms_ -= slice_ms;
+  if (stop_requested_ || backoff_left_ms_ > 0) return;
+  backoff_left_ms_ = -1;
   try {
-    start();
+    start(false);
   } catch (const FrameSourceError& error) {
     updateStatus([&](V4l2SourceStatus& s) { s.last_error = error.what(); });
     if (config_.reconnect_max_attempts > 0 && attempt >= config_.reconnect_max_attempts)
       throw FrameSourceError("v4l2:" + config_.device + ": camera lost; gave up after " +
                              std::to_string(attempt) + " reconnect attempts; last error: " + error.what());
-    return false;
+    return;
   }
   updateStatus([&](V4l2SourceStatus& s) {
     s.reconnect_attempts = 0;
     ++s.reconnects;
   });
   spdlog::info("v4l2:{}: camera back after {} attempt(s)", config_.device, attempt);
-  return true;
 }
 
 void V4l2FrameSource::requeue(std::uint32_t index) {
@@ -509,52 +545,70 @@ void V4l2FrameSource::requeue(std::uint32_t index) {
 }
 
 std::optional<Frame> V4l2FrameSource::next() {
-  while (!stop_requested_) {
-    if (!stream_) {
-      reconnectStep();
-      continue;
+  constexpr std::chrono::milliseconds kUnbounded{std::numeric_limits<int>::max()};
+  for (;;) {
+    Frame frame;
+    switch (nextFor(kUnbounded, frame)) {
+      case SourceWait::Frame:
+        return frame;
+      case SourceWait::End:
+        return std::nullopt;
+      case SourceWait::Timeout:
+        break;
     }
-    {
-      // Every buffer lent out as a zero-copy frame: wait for one to come back.
-      std::unique_lock lock(stream_->mutex);
-      if (stream_->queued == 0) {
-        stream_->buffer_returned.wait_for(lock, std::chrono::milliseconds(config_.poll_timeout_ms),
-                                          [this] { return stream_->queued > 0 || stop_requested_.load(); });
-        continue;
-      }
-    }
-    short revents = 0;
-    const int ready = device_->poll(POLLIN, config_.poll_timeout_ms, revents);
-    if (ready == 0 || ready == -EINTR) continue;
-    if (ready < 0) {
-      lose("poll: " + errnoText(-ready));
-      continue;
-    }
-    if (revents & (POLLERR | POLLHUP | POLLNVAL)) {
-      lose(std::string("poll reported ") + ((revents & POLLHUP)   ? "POLLHUP"
-                                            : (revents & POLLERR) ? "POLLERR"
-                                                                  : "POLLNVAL"));
-      continue;
-    }
-    if (!(revents & POLLIN)) continue;
-
-    v4l2_buffer buffer{};
-    buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    buffer.memory = V4L2_MEMORY_MMAP;
-    int result = 0;
-    {
-      std::lock_guard lock(stream_->mutex);
-      result = device_->ioctl(VIDIOC_DQBUF, &buffer);
-      if (result == 0) --stream_->queued;
-    }
-    if (result == -EAGAIN || result == -EINTR) continue;
-    if (result < 0) {
-      lose("VIDIOC_DQBUF: " + errnoText(-result));
-      continue;
-    }
-    if (auto frame = handleBuffer(buffer)) return frame;
   }
-  return std::nullopt;
+}
+
+SourceWait V4l2FrameSource::nextFor(std::chrono::milliseconds timeout, Frame& out) {
+  if (stop_requested_) return SourceWait::End;
+  const int slice_ms = static_cast<int>(std::clamp<std::int64_t>(timeout.count(), 0, config_.poll_timeout_ms));
+  if (!stream_) {
+    reconnectSlice(timeout);
+    return stop_requested_ ? SourceWait::End : SourceWait::Timeout;
+  }
+  {
+    // Every buffer lent out as a zero-copy frame: wait for one to come back.
+    std::unique_lock lock(stream_->mutex);
+    if (stream_->queued == 0) {
+      stream_->buffer_returned.wait_for(lock, std::chrono::milliseconds(slice_ms),
+                                        [this] { return stream_->queued > 0 || stop_requested_.load(); });
+      return stop_requested_ ? SourceWait::End : SourceWait::Timeout;
+    }
+  }
+  short revents = 0;
+  const int ready = device_->poll(POLLIN, slice_ms, revents);
+  if (stop_requested_) return SourceWait::End;
+  if (ready == 0 || ready == -EINTR) return SourceWait::Timeout;
+  if (ready < 0) {
+    lose("poll: " + errnoText(-ready));
+    return SourceWait::Timeout;
+  }
+  if (revents & (POLLERR | POLLHUP | POLLNVAL)) {
+    lose(std::string("poll reported ") + ((revents & POLLHUP)   ? "POLLHUP"
+                                          : (revents & POLLERR) ? "POLLERR"
+                                                                : "POLLNVAL"));
+    return SourceWait::Timeout;
+  }
+  if (!(revents & POLLIN)) return SourceWait::Timeout;
+
+  v4l2_buffer buffer{};
+  buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  buffer.memory = V4L2_MEMORY_MMAP;
+  int result = 0;
+  {
+    std::lock_guard lock(stream_->mutex);
+    result = device_->ioctl(VIDIOC_DQBUF, &buffer);
+    if (result == 0) --stream_->queued;
+  }
+  if (result == -EAGAIN || result == -EINTR) return SourceWait::Timeout;
+  if (result < 0) {
+    lose("VIDIOC_DQBUF: " + errnoText(-result));
+    return SourceWait::Timeout;
+  }
+  std::optional<Frame> frame = handleBuffer(buffer);
+  if (!frame) return SourceWait::Timeout;  // skipped (counted) or the device was lost
+  out = std::move(*frame);
+  return SourceWait::Frame;
 }
 
 std::optional<Frame> V4l2FrameSource::handleBuffer(const ::v4l2_buffer& buffer) {

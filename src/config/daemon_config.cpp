@@ -215,6 +215,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     readThread(threads, "segmentation", c.pipeline.threads.segmentation);
     readThread(threads, "topology", c.pipeline.threads.topology);
     readThread(threads, "publisher", c.pipeline.threads.publisher);
+    readThread(threads, "map_writer", c.pipeline.threads.map_writer);
     threads.finish();
     p.real("filter_budget_ms", c.pipeline.filter_budget_ms, 0.1, 1000, " milliseconds");
     p.real("status_period_s", c.pipeline.status_period_s, 0.1, 60, " seconds");

@@ -134,11 +134,26 @@ void ParticleFilterTopologyStage::refresh() {
   topology_ = std::move(t);
 }
 
-void ParticleFilterTopologyStage::saveMap(const std::string& path) const {
+namespace {
+
+/// The encoded map file image; writing it is MapStore's atomic replace (temporary file, fsync, rename).
+class EncodedMap final : public MapSnapshot {
+ public:
+  explicit EncodedMap(std::string bytes) : bytes_(std::move(bytes)) {}
+  void writeTo(const std::string& path) const override { MapStore::writeAtomically(path, bytes_); }
+  std::size_t bytes() const override { return bytes_.size(); }
+
+ private:
+  std::string bytes_;
+};
+
+}  // namespace
+
+std::unique_ptr<const MapSnapshot> ParticleFilterTopologyStage::snapshotMap() const {
   std::ostringstream data;
   data << "toposlamd-frames";
   for (std::int64_t f : representative_frames_) data << ' ' << f;
-  MapStore::save(path, *filter_, data.str());
+  return std::make_unique<EncodedMap>(MapStore::encode(*filter_, data.str()));
 }
 
 }  // namespace toposlam

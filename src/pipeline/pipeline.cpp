@@ -51,7 +51,7 @@ std::string PipelineConfig::validate() const {
   const std::pair<const char*, const ThreadSettings*> thread_table[] = {
       {"threads.capture", &this->threads.capture},       {"threads.fingerprint", &this->threads.fingerprint},
       {"threads.segmentation", &this->threads.segmentation}, {"threads.topology", &this->threads.topology},
-      {"threads.publisher", &this->threads.publisher}};
+      {"threads.publisher", &this->threads.publisher},   {"threads.map_writer", &this->threads.map_writer}};
   for (const auto& [key, settings] : thread_table)
     if (std::string problem = settings->validate(); !problem.empty()) return std::string(key) + "." + problem;
   if (!(filter_budget_ms >= 0.1 && filter_budget_ms <= 1000.0))
@@ -65,6 +65,22 @@ std::string PipelineConfig::validate() const {
   if (!(heartbeat_timeout_s >= 0.5 && heartbeat_timeout_s <= 600.0))
     return rangeError("heartbeat_timeout_s", heartbeat_timeout_s, "0.5 .. 600 (seconds)");
   return "";
+}
+
+std::string statusLine(const PipelineStatus& s) {
+  char camera[128];
+  if (s.source_link == SourceLink::Reconnecting)
+    std::snprintf(camera, sizeof camera, "camera reconnecting (attempt %d, %lld reconnects, %lld lost by the driver)",
+                  s.source_reconnect_attempts + 1, static_cast<long long>(s.source_reconnects),
+                  static_cast<long long>(s.source_dropped));
+  else
+    std::snprintf(camera, sizeof camera, "camera streaming (%lld reconnects, %lld lost by the driver)",
+                  static_cast<long long>(s.source_reconnects), static_cast<long long>(s.source_dropped));
+  char text[384];
+  std::snprintf(text, sizeof text, "%s: %.1f fps, latency p99 %.1f ms, %d places, map rev %lld, %lld dropped; %s",
+                s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
+                static_cast<long long>(s.frames_dropped), camera);
+  return text;
 }
 
 LatencyStats summarizeLatencies(std::vector<double>& values_ms) {
@@ -100,6 +116,21 @@ struct Pipeline::Fingerprinted {
   cv::Mat thumbnail;
 };
 
+struct Pipeline::MapWrite {
+  std::shared_ptr<const MapSnapshot> snapshot;
+  bool final = false;         ///< the save at stop (its failure is an error, not a warning)
+  double snapshot_ms = 0.0;   ///< time the topology thread spent taking it
+};
+
+namespace {
+
+/// Records that carry a place are never dropped by the drop-oldest queues (only per-frame estimates).
+bool carriesPlace(const FrameResult& r) {
+  return r.closed_place.has_value() || !r.finished_places.empty() || r.topology != nullptr || !r.has_frame;
+}
+
+}  // namespace
+
 Pipeline::Pipeline(const PipelineConfig& config, FrameSource& source, FingerprintStage& fingerprint,
                    SegmentationStage& segmentation, TopologyStage& topology, PipelineSink& sink, const Clock& clock)
     : config_(config),
@@ -113,8 +144,9 @@ Pipeline::Pipeline(const PipelineConfig& config, FrameSource& source, Fingerprin
     throw std::invalid_argument("pipeline." + problem);
   frames_ = std::make_unique<BoundedQueue<CapturedFrame>>(static_cast<std::size_t>(config_.queues.frames));
   fingerprints_ = std::make_unique<BoundedQueue<Fingerprinted>>(static_cast<std::size_t>(config_.queues.fingerprints));
-  segmented_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.segmented));
-  results_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.results));
+  segmented_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.segmented), carriesPlace);
+  results_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.results), carriesPlace);
+  map_writes_ = std::make_unique<BoundedQueue<MapWrite>>(1);  // a newer snapshot replaces an unwritten one
   status_.state = "created";
 }
 
@@ -133,6 +165,7 @@ void Pipeline::start() {
     status_.state = "running";
   }
   // Started from the end of the chain so every consumer is waiting before its producer runs.
+  threads_.start(config_.threads.map_writer, [this] { mapWriterLoop(); });
   threads_.start(config_.threads.publisher, [this] { publisherLoop(); });
   threads_.start(config_.threads.topology, [this] { topologyLoop(); });
   threads_.start(config_.threads.segmentation, [this] { segmentationLoop(); });
@@ -140,14 +173,18 @@ void Pipeline::start() {
   threads_.start(config_.threads.capture, [this] { captureLoop(); });
 }
 
-void Pipeline::requestStop() { stop_requested_.store(true); }
+void Pipeline::requestStop() {
+  stop_requested_.store(true);
+  source_.interrupt();  // a camera that sends nothing must not hold the stop up
+}
 
 void Pipeline::wait() { threads_.joinAll(); }
 
 bool Pipeline::healthy() const {
   const double now = clock_.now();
   for (int i = 0; i < kThreadCount; ++i)
-    if (!thread_done_[i].load() && now - heartbeat_[i].load() > config_.heartbeat_timeout_s) return false;
+    if (!thread_done_[i].load() && !waiting_[i].load() && now - heartbeat_[i].load() > config_.heartbeat_timeout_s)
+      return false;
   return error().empty();
 }
 
@@ -181,11 +218,19 @@ bool Pipeline::forward(Q& queue, T&& item) {
 void Pipeline::captureLoop() {
   try {
     while (!stop_requested_.load()) {
-      std::optional<Frame> frame = source_.next();
+      Frame frame;
+      // Bounded wait: a silent or reconnecting camera still lets this thread beat and see a stop.
+      const SourceWait wait = source_.nextFor(kPollPeriod, frame);
+      const FrameSourceState state = source_.state();
       source_skipped_.store(source_.skippedFrames());
+      source_reconnecting_.store(state.link == SourceLink::Reconnecting);
+      source_reconnects_.store(state.reconnects);
+      source_reconnect_attempts_.store(state.reconnect_attempts);
+      source_dropped_.store(state.dropped);
       beat(kCapture);
-      if (!frame) break;
-      CapturedFrame captured{std::move(*frame), clock_.now()};
+      if (wait == SourceWait::End) break;
+      if (wait == SourceWait::Timeout) continue;
+      CapturedFrame captured{std::move(frame), clock_.now()};
       if (!forward(*frames_, std::move(captured))) break;  // downstream ended
       processed_[kCapture].fetch_add(1);
     }
@@ -202,8 +247,10 @@ void Pipeline::fingerprintLoop() {
   try {
     for (;;) {
       CapturedFrame captured;
+      setWaiting(kFingerprint, true);
       QueueWait wait = frames_->popFor(captured, kPollPeriod);
       beat(kFingerprint);
+      setWaiting(kFingerprint, false);
       if (wait == QueueWait::Closed) break;
       if (wait == QueueWait::Timeout) continue;
       const double t0 = clock_.now();
@@ -243,8 +290,10 @@ void Pipeline::segmentationLoop() {
   try {
     for (;;) {
       Fingerprinted in;
+      setWaiting(kSegmentation, true);
       QueueWait wait = fingerprints_->popFor(in, kPollPeriod);
       beat(kSegmentation);
+      setWaiting(kSegmentation, false);
       if (wait == QueueWait::Closed) break;
       if (wait == QueueWait::Timeout) continue;
       const double t0 = clock_.now();
@@ -264,11 +313,37 @@ void Pipeline::segmentationLoop() {
   finished_threads_.fetch_add(1);
 }
 
-void Pipeline::saveMap() {
+void Pipeline::saveMap(bool final) {
   if (config_.map_path.empty()) return;
-  topology_.saveMap(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
-  maps_saved_.fetch_add(1);
-  spdlog::info("pipeline: map saved to {}", config_.map_path);
+  const double t0 = clock_.now();
+  MapWrite job{topology_.snapshotMap(), final, 0.0};
+  job.snapshot_ms = (clock_.now() - t0) * 1e3;
+  // Periodic: never wait (an unwritten older snapshot is replaced). At stop: wait for room.
+  if (final)
+    map_writes_->pushWait(std::move(job));
+  else
+    map_writes_->push(std::move(job));
+}
+
+void Pipeline::mapWriterLoop() {
+  // Writes snapshots with their fsync here, so a slow disk never holds up the topology thread.
+  while (std::optional<MapWrite> job = map_writes_->pop()) {
+    const double t0 = clock_.now();
+    try {
+      job->snapshot->writeTo(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
+      maps_saved_.fetch_add(1);
+      spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, write {:.2f} ms "
+                   "in the map writer)",
+                   config_.map_path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
+    } catch (const std::exception& e) {
+      if (job->final)
+        recordError("saving the map to " + config_.map_path + " failed: " + e.what());
+      else
+        spdlog::warn("pipeline: periodic map save to {} failed: {}", config_.map_path, e.what());
+    }
+  }
+  map_writer_done_.set_value();
+  finished_threads_.fetch_add(1);
 }
 
 void Pipeline::topologyLoop() {
@@ -299,8 +374,10 @@ void Pipeline::topologyLoop() {
   try {
     for (;;) {
       FrameResult r;
+      setWaiting(kTopology, true);
       QueueWait wait = segmented_->popFor(r, kPollPeriod);
       beat(kTopology);
+      setWaiting(kTopology, false);
       if (wait == QueueWait::Closed) break;
       if (wait == QueueWait::Item) {
         const double t0 = clock_.now();
@@ -324,9 +401,9 @@ void Pipeline::topologyLoop() {
       }
       if (config_.map_save_period_s > 0 && clock_.now() >= next_save_s && topology_.idle()) {
         try {
-          saveMap();
+          saveMap(false);
         } catch (const std::exception& e) {
-          spdlog::warn("pipeline: periodic map save to {} failed: {}", config_.map_path, e.what());
+          spdlog::warn("pipeline: periodic map snapshot for {} failed: {}", config_.map_path, e.what());
         }
         next_save_s = clock_.now() + config_.map_save_period_s;
       }
@@ -344,11 +421,13 @@ void Pipeline::topologyLoop() {
   }
   if (clean) {
     try {
-      saveMap();
+      saveMap(true);
     } catch (const std::exception& e) {
       recordError("saving the map to " + config_.map_path + " failed: " + e.what());
     }
   }
+  map_writes_->close();
+  map_writer_done_.get_future().wait();  // the map is on disk before the publisher's last status
   segmented_->close();
   results_->close();
   thread_done_[kTopology].store(true);
@@ -374,6 +453,10 @@ void Pipeline::publisherLoop() {
     s.frames_captured = processed_[kCapture].load();
     s.frames_published = published;
     s.source_skipped = source_skipped_.load();
+    s.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
+    s.source_reconnects = source_reconnects_.load();
+    s.source_reconnect_attempts = source_reconnect_attempts_.load();
+    s.source_dropped = source_dropped_.load();
     s.latency = summarizeLatencies(window[kThreadCount]);
     const QueueCounters inputs[kThreadCount] = {QueueCounters{}, frames_->counters(), fingerprints_->counters(),
                                                 segmented_->counters(), results_->counters()};
@@ -412,8 +495,10 @@ void Pipeline::publisherLoop() {
   try {
     for (;;) {
       FrameResult r;
+      setWaiting(kPublisher, true);
       QueueWait wait = results_->popFor(r, kPollPeriod);
       beat(kPublisher);
+      setWaiting(kPublisher, false);
       if (wait == QueueWait::Item) {
         const double t0 = clock_.now();
         sink_.publish(r);

@@ -1,9 +1,11 @@
-// Fake stages for pipeline tests: a counting frame source, a fingerprint stage with hooks, a segmentation
-// that closes a place every N frames, and a topology filter whose step costs a fixed number of slices of
-// manual-clock time (so "spread over frames" is exact and needs no wall clock).
+// Fake stages for pipeline tests: a counting frame source, a camera that is away (reconnecting) or hangs,
+// a fingerprint stage with hooks, a segmentation that closes a place every N frames, and a topology filter
+// whose step costs a fixed number of slices of manual-clock time (so "spread over frames" is exact and
+// needs no wall clock).
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -21,7 +23,9 @@ class FakeSource final : public FrameSource {
   /// count < 0: endless.
   explicit FakeSource(std::int64_t count) : count_(count) {}
   std::string describe() const override { return "fake"; }
+  void interrupt() override { interrupted.store(true); }
   std::optional<Frame> next() override {
+    if (interrupted.load()) return std::nullopt;
     if (count_ >= 0 && produced_ >= count_) {
       if (on_end) on_end();
       return std::nullopt;
@@ -40,10 +44,67 @@ class FakeSource final : public FrameSource {
   std::function<void(std::int64_t)> before_frame;
   std::function<void()> on_end;
   std::atomic<int> released{0};
+  std::atomic<bool> interrupted{false};
 
  private:
   std::int64_t count_;
   std::int64_t produced_ = 0;
+};
+
+/// A camera that delivers nothing. `Mode::Reconnecting`: every nextFor() waits its timeout (woken by
+/// interrupt()) and reports no frame, with state() saying reconnecting, like V4l2FrameSource while the
+/// camera is unplugged. `Mode::Hung`: nextFor() ignores its timeout and blocks until interrupt(), like a
+/// driver call that never returns. Counts the calls so a test can wait for the capture thread to loop.
+class AbsentCameraSource final : public FrameSource {
+ public:
+  enum class Mode { Reconnecting, Hung };
+  explicit AbsentCameraSource(Mode mode) : mode_(mode) {}
+  std::string describe() const override { return "absent camera"; }
+  std::optional<Frame> next() override {
+    Frame frame;
+    while (nextFor(std::chrono::milliseconds(100), frame) == SourceWait::Timeout) {
+    }
+    return std::nullopt;
+  }
+  SourceWait nextFor(std::chrono::milliseconds timeout, Frame&) override {
+    std::unique_lock lock(mutex_);
+    ++calls_;
+    changed_.notify_all();
+    if (mode_ == Mode::Hung)
+      changed_.wait(lock, [&] { return interrupted_; });
+    else
+      changed_.wait_for(lock, timeout, [&] { return interrupted_; });
+    return interrupted_ ? SourceWait::End : SourceWait::Timeout;
+  }
+  void interrupt() override {
+    std::lock_guard lock(mutex_);
+    interrupted_ = true;
+    changed_.notify_all();
+  }
+  FrameSourceState state() const override {
+    FrameSourceState s;
+    s.link = mode_ == Mode::Reconnecting ? SourceLink::Reconnecting : SourceLink::Streaming;
+    s.reconnect_attempts = 4;
+    s.reconnects = 2;
+    s.dropped = 7;
+    return s;
+  }
+  /// Blocks until nextFor() has been entered `n` times in all.
+  void waitForCalls(int n) {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return calls_ >= n; });
+  }
+  int calls() {
+    std::lock_guard lock(mutex_);
+    return calls_;
+  }
+
+ private:
+  Mode mode_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  int calls_ = 0;
+  bool interrupted_ = false;
 };
 
 class FakeFingerprint final : public FingerprintStage {
@@ -67,6 +128,7 @@ class FakeSegmentation final : public SegmentationStage {
   SegmentationStep process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
                            const cv::Mat& thumbnail) override {
     if (throw_at >= 0 && sequence == throw_at) throw std::runtime_error("boom");
+    if (after_frame) after_frame(sequence);
     SegmentationStep step;
     step.lambda2 = static_cast<double>(sequence);
     if ((sequence + 1) % period_ == 0) {
@@ -83,6 +145,7 @@ class FakeSegmentation final : public SegmentationStage {
   }
   int closed = 0;
   std::int64_t throw_at = -1;
+  std::function<void(std::int64_t)> after_frame;  ///< called with each frame's sequence
 
  private:
   int period_;
@@ -121,11 +184,30 @@ class FakeTopology final : public TopologyStage {
     t.map_revision = revision_;
     return t;
   }
-  void saveMap(const std::string& path) const override {
-    saves.push_back(path);
-    saved_while_idle.push_back(idle());
-    saved_at_revision.push_back(revision_);
+  /// The snapshot records when it was taken; its write records where (on the map writer thread).
+  class Snapshot final : public MapSnapshot {
+   public:
+    Snapshot(const FakeTopology& owner, bool idle, std::int64_t revision)
+        : owner_(owner), idle_(idle), revision_(revision) {}
+    void writeTo(const std::string& path) const override {
+      if (owner_.on_write) owner_.on_write();
+      std::lock_guard lock(owner_.saves_mutex);
+      owner_.saves.push_back(path);
+      owner_.saved_while_idle.push_back(idle_);
+      owner_.saved_at_revision.push_back(revision_);
+    }
+    std::size_t bytes() const override { return 8; }
+
+   private:
+    const FakeTopology& owner_;
+    bool idle_;
+    std::int64_t revision_;
+  };
+  std::unique_ptr<const MapSnapshot> snapshotMap() const override {
+    return std::make_unique<Snapshot>(*this, idle(), revision_);
   }
+  std::function<void()> on_write;  ///< called on the map writer thread before each write (e.g. a slow disk)
+  mutable std::mutex saves_mutex;
   mutable std::vector<std::string> saves;
   mutable std::vector<bool> saved_while_idle;
   mutable std::vector<std::int64_t> saved_at_revision;
@@ -144,6 +226,7 @@ class FakeTopology final : public TopologyStage {
 class RecordingSink final : public PipelineSink {
  public:
   void publish(const FrameResult& r) override {
+    if (before_publish) before_publish(r);
     std::lock_guard lock(mutex_);
     results.push_back(r);
     if (r.has_frame) ++frames;
@@ -152,11 +235,29 @@ class RecordingSink final : public PipelineSink {
   void publishStatus(const PipelineStatus& s) override {
     std::lock_guard lock(mutex_);
     statuses.push_back(s);
+    changed_.notify_all();
+  }
+  /// Blocks until a status satisfying `wanted` was published; returns a copy of it.
+  PipelineStatus waitForStatus(const std::function<bool(const PipelineStatus&)>& wanted) {
+    std::unique_lock lock(mutex_);
+    const PipelineStatus* found = nullptr;
+    changed_.wait(lock, [&] {
+      for (const PipelineStatus& s : statuses)
+        if (wanted(s)) found = &s;
+      return found != nullptr;
+    });
+    return *found;
   }
   void waitForFrames(int n) {
     std::unique_lock lock(mutex_);
     changed_.wait(lock, [&] { return frames >= n; });
   }
+  /// Like waitForFrames() but gives up after `limit` (a guard against a hang, not a timing). True if seen.
+  bool waitForFramesFor(int n, std::chrono::seconds limit) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, limit, [&] { return frames >= n; });
+  }
+  std::function<void(const FrameResult&)> before_publish;  ///< e.g. a slow consumer
   std::vector<FrameResult> results;
   std::vector<PipelineStatus> statuses;
   int frames = 0;

@@ -130,3 +130,67 @@ SCENARIO("Concurrent producers and consumers lose nothing in lossless mode and a
 SCENARIO("A queue needs room for at least one item") {
   CHECK_THROWS_AS(BoundedQueue<int>(0), std::invalid_argument);
 }
+
+SCENARIO("GIVEN items that must be kept WHEN the queue overflows THEN only droppable items are dropped") {
+  // Even numbers stand for records that carry a place: never dropped.
+  BoundedQueue<int> queue(3, [](const int& item) { return item % 2 == 0; });
+  WHEN("a full queue [0, 1, 2] takes 3, then 4") {
+    REQUIRE(queue.push(0));
+    REQUIRE(queue.push(1));
+    REQUIRE(queue.push(2));
+    REQUIRE(queue.push(3));  // drops 1, the oldest droppable
+    REQUIRE(queue.push(4));  // drops 3
+    THEN("the kept items stay in order and two drops are counted") {
+      CHECK(queue.counters().dropped == 2);
+      CHECK(queue.pop() == 0);
+      CHECK(queue.pop() == 2);
+      CHECK(queue.pop() == 4);
+    }
+  }
+  WHEN("the queue is full of kept items and a droppable one arrives") {
+    REQUIRE(queue.push(0));
+    REQUIRE(queue.push(2));
+    REQUIRE(queue.push(4));
+    REQUIRE(queue.push(5));
+    THEN("the newcomer is the one dropped") {
+      const auto c = queue.counters();
+      CHECK(c.dropped == 1);
+      CHECK(c.pushed == 4);
+      CHECK(c.depth == 3);
+      CHECK(queue.pop() == 0);
+      CHECK(queue.pop() == 2);
+      CHECK(queue.pop() == 4);
+    }
+  }
+  WHEN("the queue is full of kept items and another kept one arrives") {
+    REQUIRE(queue.push(0));
+    REQUIRE(queue.push(2));
+    REQUIRE(queue.push(4));
+    std::atomic<bool> pushed{false};
+    std::thread producer([&] { pushed = queue.push(6); });
+    THEN("the producer waits for room instead of dropping, and is counted") {
+      CHECK(queue.pop() == 0);  // makes room
+      producer.join();
+      CHECK(pushed.load());
+      const auto c = queue.counters();
+      CHECK(c.dropped == 0);
+      CHECK(queue.pop() == 2);
+      CHECK(queue.pop() == 4);
+      CHECK(queue.pop() == 6);
+      CHECK(c.kept_waits <= 1);  // 0 if the pop made room before the push
+    }
+  }
+  WHEN("a producer waits on a full queue of kept items and the queue is closed") {
+    REQUIRE(queue.push(0));
+    REQUIRE(queue.push(2));
+    REQUIRE(queue.push(4));
+    std::atomic<int> result{-1};
+    std::thread producer([&] { result = queue.push(8) ? 1 : 0; });
+    queue.close();
+    producer.join();
+    THEN("the push is refused, not left hanging") {
+      CHECK(result.load() == 0);
+      CHECK(queue.counters().refused == 1);
+    }
+  }
+}

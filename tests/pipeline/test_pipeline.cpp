@@ -1,8 +1,12 @@
 // Pipeline with fake stages: order and completeness, the filter step spread over frames within the
-// per-frame budget, counted drops (not growth) behind a slow stage, clean stop (step finished, map saved
-// once while idle), stage failures, bad frames, status.
+// per-frame budget, counted drops (not growth) behind a slow stage that never lose a place, clean stop
+// (step finished, map saved once while idle), stage failures, bad frames, status; a camera away for long
+// (healthy, status "reconnecting") versus a source hung in a call (unhealthy), stop with a silent camera,
+// and a slow map write that does not hold up the frames.
 #include <catch2/catch.hpp>
 
+#include <atomic>
+#include <chrono>
 #include <future>
 #include <set>
 
@@ -13,6 +17,9 @@ using namespace toposlam;
 using namespace toposlam::test;
 
 namespace {
+
+constexpr std::size_t kTopologyStage = 3;   // PipelineStatus::stages index (input: segmented queue)
+constexpr std::size_t kPublisherStage = 4;  // (input: results queue)
 
 PipelineConfig losslessConfig() {
   PipelineConfig c;
@@ -252,4 +259,177 @@ SCENARIO("Latency summaries: median, nearest-rank p99 and max") {
   s = summarizeLatencies(none);
   CHECK(s.samples == 0);
   CHECK(s.max_ms == 0.0);
+}
+
+namespace {
+
+/// Waits (bounded, as a guard against a hang) for `pipeline` to end after requestStop(); true if it did.
+bool stopsWithin(Pipeline& pipeline, FrameSource& source, std::chrono::seconds limit) {
+  pipeline.requestStop();
+  auto joined = std::async(std::launch::async, [&] { pipeline.wait(); });
+  const bool ended = joined.wait_for(limit) == std::future_status::ready;
+  if (!ended) source.interrupt();  // let the test end (and fail) instead of hanging
+  joined.get();
+  return ended;
+}
+
+}  // namespace
+
+SCENARIO("GIVEN a camera reconnecting for longer than the heartbeat limit THEN the pipeline stays healthy and says so") {
+  ManualClock clock;
+  AbsentCameraSource source(AbsentCameraSource::Mode::Reconnecting);
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  PipelineConfig config = losslessConfig();
+  config.queues.overflow = QueueOverflow::DropOldest;
+  config.heartbeat_timeout_s = 5.0;
+  config.status_period_s = 1.0;
+  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  pipeline.start();
+  source.waitForCalls(1);
+  WHEN("12 s pass in steps of 3 s (each step: the capture thread comes back from the source and beats)") {
+    for (int step = 1; step <= 4; ++step) {
+      clock.advance(3.0);
+      source.waitForCalls(source.calls() + 2);  // the call in progress returned (beat), and the next began
+      INFO("after " << 3 * step << " s without a frame");
+      CHECK(pipeline.healthy());
+    }
+    THEN("the status reports the camera reconnecting with its counters, and stop returns") {
+      const PipelineStatus s = sink.waitForStatus([](const PipelineStatus& st) { return st.time_s >= 12.0; });
+      CHECK(s.source_link == SourceLink::Reconnecting);
+      CHECK(s.source_reconnects == 2);
+      CHECK(s.source_reconnect_attempts == 4);
+      CHECK(s.source_dropped == 7);
+      CHECK(s.frames_captured == 0);
+      CHECK_THAT(statusLine(s), Catch::StartsWith("running: ") &&
+                                    Catch::Contains("camera reconnecting (attempt 5, 2 reconnects, 7 lost by the driver)"));
+      CHECK(stopsWithin(pipeline, source, std::chrono::seconds(10)));
+      CHECK(pipeline.error().empty());
+      CHECK(pipeline.finished());
+    }
+  }
+}
+
+SCENARIO("GIVEN a source hung inside next() THEN the pipeline is unhealthy (stalled) and stop still returns") {
+  ManualClock clock;
+  AbsentCameraSource source(AbsentCameraSource::Mode::Hung);
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  PipelineConfig config = losslessConfig();
+  config.heartbeat_timeout_s = 5.0;
+  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  pipeline.start();
+  source.waitForCalls(1);
+  CHECK(pipeline.healthy());
+  clock.advance(6.0);
+  CHECK_FALSE(pipeline.healthy());  // the capture thread has been inside the source for 6 s > 5 s
+  THEN("requestStop() interrupts the source: the threads end and the map is saved once") {
+    REQUIRE(stopsWithin(pipeline, source, std::chrono::seconds(10)));
+    CHECK(pipeline.finished());
+    CHECK(pipeline.error().empty());
+    CHECK(topology.saves.size() == 1);
+  }
+}
+
+SCENARIO("GIVEN a publisher that falls far behind WHEN drop-oldest queues overflow THEN only per-frame estimates are dropped") {
+  ManualClock clock;
+  FakeSource source(120);
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(3);  // places close on frames 2, 5, 8, ...: 40 places
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  // The publisher holds its first record until segmentation has seen 60 frames: the topology thread
+  // produces about 60 records into a results queue of 16 (20 of them carry a place, which all fit).
+  std::promise<void> sixty_frames_segmented;
+  std::shared_future<void> gate = sixty_frames_segmented.get_future().share();
+  segmentation.after_frame = [&](std::int64_t sequence) {
+    if (sequence == 59) sixty_frames_segmented.set_value();
+  };
+  sink.before_publish = [&](const FrameResult&) { gate.wait(); };
+  PipelineConfig config = losslessConfig();
+  config.queues.overflow = QueueOverflow::DropOldest;
+  config.queues.frames = 1024;  // upstream lossless: every frame reaches segmentation
+  config.queues.fingerprints = 1024;
+  config.queues.segmented = 16;
+  config.queues.results = 16;
+  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  pipeline.start();
+  pipeline.wait();
+  REQUIRE(pipeline.error().empty());
+  THEN("every place got its step and was published exactly once, in order, while estimates were dropped and counted") {
+    CHECK(segmentation.closed == 40);
+    std::vector<int> places;
+    std::int64_t estimates = 0;
+    for (const FrameResult& r : sink.results) {
+      if (r.has_frame) ++estimates;
+      for (const auto& [place, assignment] : r.finished_places) places.push_back(assignment.place);
+    }
+    std::vector<int> expected(40);
+    for (int p = 0; p < 40; ++p) expected[static_cast<std::size_t>(p)] = p;
+    CHECK(places == expected);
+    REQUIRE_FALSE(sink.statuses.empty());
+    const PipelineStatus& s = sink.statuses.back();
+    // When segmentation began frame 59, 59 records existed; at most 16 + 16 queued, one held by the
+    // publisher and one by the topology thread: at least 25 were dropped, from these two queues only.
+    CHECK(s.frames_dropped >= 59 - 16 - 16 - 2);
+    CHECK(s.frames_dropped == s.stages[kPublisherStage].dropped + s.stages[kTopologyStage].dropped);
+    CHECK(estimates == 120 - s.frames_dropped);
+  }
+}
+
+SCENARIO("GIVEN a slow disk WHEN the map is saved periodically THEN frames keep flowing while it is written") {
+  ManualClock clock;
+  FakeSource source(200);
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  std::promise<void> disk_free;
+  std::shared_future<void> free = disk_free.get_future().share();
+  std::atomic<int> writes_started{0};
+  topology.on_write = [&] {
+    if (writes_started.fetch_add(1) == 0) free.wait();  // the first (periodic) write hangs on the disk
+  };
+  source.before_frame = [&, once = false](std::int64_t i) mutable {
+    if (i == 20 && !once) {
+      once = true;
+      clock.advance(2.0);  // past the 1 s save period: the topology thread snapshots at its next record
+    }
+  };
+  PipelineConfig config = losslessConfig();
+  config.map_save_period_s = 1.0;
+  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  pipeline.start();
+  const bool all_published = sink.waitForFramesFor(200, std::chrono::seconds(10));
+  const int writes_while_blocked = writes_started.load();
+  disk_free.set_value();
+  pipeline.wait();
+  THEN("all 200 frames were published while the periodic write was still blocked; then the final save followed") {
+    CHECK(all_published);
+    CHECK(writes_while_blocked == 1);
+    REQUIRE(topology.saves.size() == 2);
+    CHECK(topology.saved_while_idle[0]);
+    CHECK(topology.saved_at_revision[1] == 20);  // the final save has every step
+    CHECK(pipeline.error().empty());
+    REQUIRE_FALSE(sink.statuses.empty());
+    CHECK(sink.statuses.back().maps_saved == 2);
+  }
+}
+
+SCENARIO("The status line names the camera state") {
+  PipelineStatus s;
+  s.state = "running";
+  s.fps = 29.84;
+  s.places = 4;
+  s.map_revision = 4;
+  CHECK(statusLine(s) == "running: 29.8 fps, latency p99 0.0 ms, 4 places, map rev 4, 0 dropped; camera streaming (0 "
+                         "reconnects, 0 lost by the driver)");
+  s.source_link = SourceLink::Reconnecting;
+  s.source_reconnect_attempts = 0;
+  s.source_reconnects = 1;
+  CHECK_THAT(statusLine(s), Catch::EndsWith("camera reconnecting (attempt 1, 1 reconnects, 0 lost by the driver)"));
 }

@@ -48,7 +48,7 @@ struct FakeV4l2State {
   // Script.
   std::deque<FakeV4l2Event> events;
   std::deque<int> open_errors;    ///< errno for the next open() calls (consumed one per call)
-  std::function<void()> on_idle;  ///< called when the script is exhausted (e.g. requestStop)
+  std::function<void()> on_idle;  ///< called when the script is exhausted (e.g. interrupt)
 
   // Observations.
   int opens = 0;

@@ -81,7 +81,7 @@ struct Rig {
     };
     source = std::make_unique<V4l2FrameSource>(
         config, std::make_unique<toposlam::test::FakeV4l2Device>(state), runtime);
-    state.on_idle = [this] { source->requestStop(); };
+    state.on_idle = [this] { source->interrupt(); };
   }
   /// All frames until the script runs out.
   std::vector<toposlam::Frame> drain() {
@@ -170,6 +170,7 @@ SCENARIO(
   CHECK(frames[2].sequence == 4);
   CHECK(frames[4].sequence == 10);
   CHECK(rig.source->droppedFrames() == 2 + 4);
+  CHECK(rig.source->state().dropped == 2 + 4);  // what the pipeline's status shows
 }
 
 SCENARIO(
@@ -447,4 +448,81 @@ SCENARIO("GIVEN v4l2 URIs WHEN parsed THEN parameters are read and bad ones name
                     Catch::Contains("unknown parameter 'zoom'"));
   CHECK_THROWS_WITH(toposlam::parseV4l2Uri("v4l2:video0"), Catch::Contains("expected a device path"));
   CHECK_THROWS_AS(toposlam::parseV4l2Uri("images:/tmp"), FrameSourceError);
+}
+
+SCENARIO("GIVEN an unplugged camera WHEN read with nextFor THEN every call returns within one slice, reporting reconnecting") {
+  Rig rig;
+  auto config = smallConfig();
+  config.reconnect_initial_ms = 100;
+  config.reconnect_max_ms = 400;
+  rig.open(config);
+  rig.state.events.push_back(errorEvent(Kind::PollHangup));
+  rig.state.open_errors = {ENOENT, ENOENT};  // attempts 1 and 2 fail, attempt 3 opens the camera
+  toposlam::Frame frame;
+  std::vector<toposlam::FrameSourceState> states;
+  toposlam::SourceWait wait = toposlam::SourceWait::Timeout;
+  for (int call = 0; call < 100 && wait == toposlam::SourceWait::Timeout; ++call) {
+    if (call == 10) rig.state.events.push_back(frameEvent(yuyv(kWidth, kHeight, 128, 128, 128), 0));
+    wait = rig.source->nextFor(std::chrono::milliseconds(50), frame);
+    states.push_back(rig.source->state());
+  }
+  REQUIRE(wait == toposlam::SourceWait::Frame);
+  THEN("the backoff (100 + 200 + 400 ms) was waited in slices of at most 50 ms, one per call") {
+    using std::chrono::milliseconds;
+    CHECK(rig.sleeps.size() == 14);
+    CHECK(std::all_of(rig.sleeps.begin(), rig.sleeps.end(), [](milliseconds d) { return d <= milliseconds(50); }));
+    milliseconds total{0};
+    for (const milliseconds d : rig.sleeps) total += d;
+    CHECK(total == milliseconds(700));
+    CHECK(states.front().link == toposlam::SourceLink::Reconnecting);
+    CHECK(states[2].reconnect_attempts == 1);
+    CHECK(states.back().link == toposlam::SourceLink::Streaming);
+    CHECK(states.back().reconnects == 1);
+  }
+}
+
+SCENARIO("GIVEN a reconnect backoff in progress WHEN interrupt() is called THEN nextFor ends the stream") {
+  Rig rig;
+  rig.open(smallConfig());
+  rig.state.events.push_back(errorEvent(Kind::Unplug));
+  rig.during_sleep = [&] { rig.source->interrupt(); };
+  toposlam::Frame frame;
+  CHECK(rig.source->nextFor(std::chrono::milliseconds(50), frame) == toposlam::SourceWait::Timeout);  // lost
+  CHECK(rig.source->nextFor(std::chrono::milliseconds(50), frame) == toposlam::SourceWait::End);
+  CHECK(rig.source->nextFor(std::chrono::milliseconds(50), frame) == toposlam::SourceWait::End);
+  CHECK_FALSE(rig.source->next());
+}
+
+SCENARIO("GIVEN wait_at_start and no device node yet WHEN the source is made THEN it waits for the camera") {
+  Rig rig;
+  auto config = smallConfig();
+  config.wait_at_start = true;
+  rig.state.open_errors = {ENOENT, ENOENT};  // at start, then attempt 1; attempt 2 opens it
+  rig.open(config);
+  CHECK(rig.source->state().link == toposlam::SourceLink::Reconnecting);
+  CHECK(rig.source->describe().find("(reconnecting)") != std::string::npos);
+  CHECK(rig.state.opens == 0);
+  rig.state.events.push_back(frameEvent(yuyv(kWidth, kHeight, 128, 128, 128), 0));
+  const auto frames = rig.drain();
+  REQUIRE(frames.size() == 1);
+  CHECK(rig.state.opens == 1);
+  CHECK(rig.source->state().link == toposlam::SourceLink::Streaming);
+  CHECK(rig.source->status().reconnects == 1);
+  AND_WHEN("the node exists but cannot be used (permissions)") {
+    Rig denied;
+    denied.state.open_errors = {EACCES};
+    THEN("waiting does not hide it: the constructor fails with the hint") {
+      CHECK_THROWS_WITH(denied.open(config), Catch::Contains("video' group"));
+    }
+  }
+}
+
+SCENARIO("GIVEN the URI key wait WHEN parsed THEN 0 and 1 are accepted and anything else is refused by name") {
+  CHECK(toposlam::parseV4l2Uri("v4l2:/dev/video0?wait=1").wait_at_start);
+  CHECK_FALSE(toposlam::parseV4l2Uri("v4l2:/dev/video0?wait=0").wait_at_start);
+  toposlam::V4l2SourceConfig waiting;
+  waiting.wait_at_start = true;
+  CHECK(toposlam::parseV4l2Uri("v4l2:/dev/video0", waiting).wait_at_start);  // the daemon's default
+  CHECK_FALSE(toposlam::parseV4l2Uri("v4l2:/dev/video0?wait=0", waiting).wait_at_start);
+  CHECK_THROWS_WITH(toposlam::parseV4l2Uri("v4l2:/dev/video0?wait=yes"), Catch::StartsWith("v4l2: wait: "));
 }

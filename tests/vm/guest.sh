@@ -6,8 +6,9 @@
 #      and carries on;
 #   2. v4l2loopback fed the bundled frames as YUYV by ffmpeg: `toposlam capture` receives frames with
 #      increasing sequence numbers and monotonic timestamps;
-#   3. toposlamd (when built) on the loopback device, publishing over LCM on lo, checked by a subscriber.
-# Prints "VMTEST PASS|FAIL|SKIP <what>" lines for tests/vm/run-vm-test.sh, then "VMTEST DONE failures=N".
+#   3. toposlamd on the loopback device, publishing over LCM on lo, checked by a subscriber (a missing
+#      toposlamd binary is a failure, not a skip).
+# Prints "VMTEST PASS|FAIL <what>" lines for tests/vm/run-vm-test.sh, then "VMTEST DONE failures=N".
 # Usage (from the initramfs init): guest.sh BUILD_DIR
 build=${1:?usage: guest.sh BUILD_DIR}
 toposlam=$build/src/apps/toposlam/toposlam
@@ -45,6 +46,7 @@ check_capture_log() {  # log expected_frames what
 
 echo "VMTEST kernel $(uname -r), $(ls /dev/video* | tr '\n' ' ')"
 [ -x "$toposlam" ] || { fail "no toposlam binary at $toposlam (build it first)"; echo "VMTEST DONE failures=$failures"; exit 1; }
+[ -x "$toposlamd" ] || fail "no toposlamd binary at $toposlamd (build it first)"
 samples=$(cd "$(dirname "$0")/../data/rtabmap-samples/samples" && pwd)
 
 # Under TCG, starting a big dynamically linked program takes 10-20 s (toposlam maps ~250 libraries), so
@@ -54,10 +56,8 @@ ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev
 ffmpeg -nostdin -loglevel error -re -stream_loop 20 -framerate 10 -start_number 1 -i "$samples/%d.jpg" \
   -vf scale=320:240 -pix_fmt yuyv422 -f v4l2 /dev/video0 &
 writer=$!
-if [ -x "$toposlamd" ]; then
-  "$toposlam" listen --channels TOPOSLAM_PLACE,TOPOSLAM_PLACE_EVENT,TOPOSLAM_STATUS --timeout 170 >listen.txt 2>&1 &
-  listener=$!
-fi
+"$toposlam" listen --channels TOPOSLAM_PLACE,TOPOSLAM_PLACE_EVENT,TOPOSLAM_STATUS --timeout 170 >listen.txt 2>&1 &
+listener=$!
 
 # --- vivid (the kernel's test driver), BGR24 zero copy, with an unplug in the middle -----------------
 vivid=""
@@ -101,8 +101,6 @@ fi
 # --- toposlamd over LCM, on the same loopback camera ----------------------------------------------------
 if [ -x "$toposlamd" ]; then
   . "$(dirname "$0")/guest-daemon.sh"
-else
-  echo "VMTEST SKIP toposlamd: not built in $build"
 fi
 kill $writer 2>/dev/null; wait $writer 2>/dev/null
 

@@ -3,8 +3,11 @@
 # v4l2loopback and vivid loaded, shares this machine's root read-only over 9p and runs the real
 # toposlam binaries from BUILD_DIR inside (tests/vm/guest.sh). Passes when every guest check passed.
 # Exit 77 (skipped) only when QEMU cannot run here at all (no qemu-system-x86_64).
+# The whole test (prepare + boot + guest) must finish within TOPOSLAM_VM_BUDGET seconds (default 175; ctest
+# stops it at 180): the VM gets what the preparation left of it, and a test over budget fails.
 # Usage: tests/vm/run-vm-test.sh BUILD_DIR [CACHE_DIR]    (CACHE_DIR default BUILD_DIR/vm-cache)
-# Environment: TOPOSLAM_VM_TIMEOUT (seconds for the whole boot-to-poweroff, default 170),
+# Environment: TOPOSLAM_VM_BUDGET (seconds for the whole test, default 175),
+#              TOPOSLAM_VM_TIMEOUT (seconds for boot-to-poweroff, default: what is left of the budget),
 #              TOPOSLAM_VM_SMP (guest CPUs, default 2),
 #              TOPOSLAM_VM_DAEMON (another toposlamd binary to run inside instead of BUILD_DIR's).
 set -euo pipefail
@@ -33,7 +36,10 @@ prepared=$(date +%s)
 echo "vm-test: kernel $kver prepared in $((prepared - started)) s; booting"
 
 log="$build/vm-test.log"
-timeout_s=${TOPOSLAM_VM_TIMEOUT:-170}
+budget_s=${TOPOSLAM_VM_BUDGET:-175}
+left_s=$((budget_s - (prepared - started) - 5))  # 5 s for qemu's own exit and this script
+[ "$left_s" -ge 60 ] || { echo "vm-test: FAILED: preparing took $((prepared - started)) s, leaving $left_s s of the ${budget_s} s budget"; exit 1; }
+timeout_s=${TOPOSLAM_VM_TIMEOUT:-$left_s}
 set +e
 timeout --kill-after=5 "$timeout_s" "$qemu" -accel tcg -m 1024 -smp "${TOPOSLAM_VM_SMP:-2}" \
   -kernel "$cache/vmlinuz" -initrd "$initrd" \
@@ -52,4 +58,7 @@ fi
 grep -q "VMTEST BOOTED" "$log" || { echo "vm-test: FAILED: the guest did not boot (see $log)"; exit 1; }
 grep -q "VMTEST DONE failures=0" "$log" || { echo "vm-test: FAILED: guest checks failed"; exit 1; }
 if grep -q "VMTEST FAIL" "$log"; then echo "vm-test: FAILED"; exit 1; fi
+if [ $((finished - started)) -gt "$budget_s" ]; then
+  echo "vm-test: FAILED: took $((finished - started)) s, over the ${budget_s} s budget"; exit 1
+fi
 echo "vm-test: PASSED"

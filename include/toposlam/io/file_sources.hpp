@@ -1,8 +1,9 @@
 // Frame sources over files: an image folder or glob, played in natural order, and a video file.
 // Bad files (unreadable, truncated, undecodable) are skipped, counted and logged; the stream goes on.
-// Not thread-safe: one consumer calls next().
+// Not thread-safe: one consumer calls next(); interrupt() (ends the stream early) from any thread.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -32,6 +33,7 @@ class ImageFilesSource : public FrameSource {
   ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0);
   std::string describe() const override;
   std::optional<Frame> next() override;
+  void interrupt() override { interrupted_.store(true); }
   std::int64_t skippedFrames() const override { return skipped_; }
   std::int64_t frameCountHint() const override { return static_cast<std::int64_t>(files_.size()); }
   const std::vector<std::string>& files() const { return files_; }
@@ -42,6 +44,7 @@ class ImageFilesSource : public FrameSource {
   double rate_hz_;
   std::size_t next_index_ = 0;
   std::int64_t skipped_ = 0;
+  std::atomic<bool> interrupted_{false};
 };
 
 class VideoFileSource : public FrameSource {
@@ -51,6 +54,7 @@ class VideoFileSource : public FrameSource {
   explicit VideoFileSource(const std::string& path, double timestamp_rate_hz = 0.0);
   std::string describe() const override;
   std::optional<Frame> next() override;
+  void interrupt() override { interrupted_.store(true); }
   std::int64_t skippedFrames() const override { return skipped_; }
   std::int64_t frameCountHint() const override { return frame_count_; }
 
@@ -62,6 +66,7 @@ class VideoFileSource : public FrameSource {
   std::int64_t frame_count_ = -1;
   std::int64_t next_index_ = 0;
   std::int64_t skipped_ = 0;
+  std::atomic<bool> interrupted_{false};
 };
 
 }  // namespace toposlam

@@ -1,7 +1,14 @@
 // Frames enter toposlam through one interface, whatever produced them: an image folder, a video file,
 // the simulated world, a V4L2 or libcamera camera. Sources are opened by URI (see openFrameSource).
+//
+// Two ways to read: next() blocks until a frame or the end (offline tools); nextFor() waits at most
+// about a given time, so a real-time consumer (the pipeline's capture thread) keeps beating its
+// heartbeat and noticing a stop while a camera is silent or being reconnected. interrupt() makes a
+// blocked or future read end promptly, from any thread. state() says what a live source is doing
+// (streaming or reconnecting, and its counters), from any thread.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,14 +34,51 @@ class FrameSourceError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Outcome of FrameSource::nextFor().
+enum class SourceWait {
+  Frame,    ///< a frame was returned
+  Timeout,  ///< no frame within the time (camera silent, reconnecting, a bad frame skipped): call again
+  End,      ///< end of the stream, or interrupt() was called: no more frames
+};
+
+/// Whether a live source is delivering or trying to get its camera back.
+enum class SourceLink { Streaming, Reconnecting };
+
+inline const char* toString(SourceLink link) {
+  return link == SourceLink::Reconnecting ? "reconnecting" : "streaming";
+}
+
+/// A snapshot of what a source is doing (no strings: read on the frame path).
+struct FrameSourceState {
+  SourceLink link = SourceLink::Streaming;
+  std::int64_t reconnects = 0;   ///< outages survived (successful reopenings)
+  int reconnect_attempts = 0;    ///< failed attempts in the current outage
+  std::int64_t dropped = 0;      ///< frames lost according to the driver's sequence gaps
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
   /// Human-readable description, e.g. "images:/data/run1 (84 frames)".
   virtual std::string describe() const = 0;
-  /// Next frame, or std::nullopt at the end of the stream. A single bad frame (corrupt file, decode
-  /// failure) is skipped and counted, not thrown; FrameSourceError means the source cannot go on.
+  /// Next frame, or std::nullopt at the end of the stream (or after interrupt()). A single bad frame
+  /// (corrupt file, decode failure) is skipped and counted, not thrown; FrameSourceError means the
+  /// source cannot go on.
   virtual std::optional<Frame> next() = 0;
+  /// Like next() but returns within about `timeout` (plus the time of one non-blocking driver call or
+  /// one file decode). The default suits sources whose next() never waits long (files, sim).
+  virtual SourceWait nextFor(std::chrono::milliseconds timeout, Frame& out) {
+    (void)timeout;
+    std::optional<Frame> frame = next();
+    if (!frame) return SourceWait::End;
+    out = std::move(*frame);
+    return SourceWait::Frame;
+  }
+  /// Makes a blocked or future next()/nextFor() end promptly (std::nullopt / End). Thread-safe: any
+  /// thread, any number of times.
+  virtual void interrupt() = 0;
+  /// What the source is doing now. Thread-safe: any thread.
+  virtual FrameSourceState state() const { return {}; }
   /// Frames skipped because they were bad (corrupt, truncated, failed to decode).
   virtual std::int64_t skippedFrames() const { return 0; }
   /// Total frames if known in advance (files), else -1 (cameras).

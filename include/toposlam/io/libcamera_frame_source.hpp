@@ -9,7 +9,8 @@
 // YUYV, MJPEG) are converted and the request re-queued right away. If the consumer falls behind, the
 // oldest completed request is re-queued unseen and counted as dropped (a bounded hand-off queue).
 //
-// Thread-safety: next() from one thread; requestStop(), the counters and lease releases from any.
+// Thread-safety: next()/nextFor() from one thread; interrupt(), state(), the counters and lease releases
+// from any.
 // libcamera allows one CameraManager per process: sources share one while any is alive.
 #pragma once
 
@@ -57,11 +58,15 @@ class LibcameraFrameSource : public FrameSource {
   LibcameraFrameSource& operator=(const LibcameraFrameSource&) = delete;
 
   std::string describe() const override;
-  /// Blocks for the next completed request; std::nullopt after requestStop().
+  /// Blocks for the next completed request; std::nullopt after interrupt(). FrameSourceError when no
+  /// frame came for timeout_ms.
   std::optional<Frame> next() override;
+  /// Waits at most `timeout` (Timeout: call again); throws like next() after timeout_ms without a frame.
+  SourceWait nextFor(std::chrono::milliseconds timeout, Frame& out) override;
+  void interrupt() override;
+  FrameSourceState state() const override;  ///< always streaming; `dropped` = requests re-queued unseen
   std::int64_t skippedFrames() const override;
   std::int64_t droppedFrames() const;
-  void requestStop();
 
   struct Impl;  // libcamera objects, kept out of this header; shared with frame leases
 

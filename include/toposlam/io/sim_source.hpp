@@ -2,9 +2,10 @@
 // simulated seconds; the ground truth of the last frame is available for end-to-end tests.
 // Query keys: route, fps, size, seed, speed (m/s), fov (degrees), light (day|night|warm|cool),
 // noise (grey levels), people (count), pitch (degrees), moved (0|1), and the common rate.
-// Not thread-safe: one consumer calls next().
+// Not thread-safe: one consumer calls next(); interrupt() (ends the stream early) from any thread.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,6 +25,7 @@ class SimFrameSource : public FrameSource {
   explicit SimFrameSource(const sim::SimConfig& config);
   std::string describe() const override;
   std::optional<Frame> next() override;
+  void interrupt() override { interrupted_.store(true); }
   std::int64_t frameCountHint() const override { return simulator_->frameCount(); }
   const sim::Simulator& simulator() const { return *simulator_; }
   /// Ground truth of the frame last returned by next() (default values before the first).
@@ -32,6 +34,7 @@ class SimFrameSource : public FrameSource {
  private:
   std::unique_ptr<sim::Simulator> simulator_;
   sim::GroundTruth last_truth_;
+  std::atomic<bool> interrupted_{false};
 };
 
 }  // namespace toposlam

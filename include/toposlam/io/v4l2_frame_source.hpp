@@ -14,11 +14,18 @@
 // the driver does not stamp buffers with the monotonic clock.
 //
 // Unplug (POLLERR/POLLHUP from poll, ENODEV or another hard error from an ioctl) closes the device and
-// reopens it with exponential backoff inside next(); the caller just keeps calling next(). status()
-// says whether the camera is connected or reconnecting and how many attempts were made.
+// reopens it with exponential backoff; the caller just keeps calling next() or nextFor(). nextFor()
+// waits at most its timeout per call (one poll slice or one slice of the backoff), so a real-time
+// caller keeps its heartbeat while the camera is silent or away. status() and state() say whether the
+// camera is connected or reconnecting and how many attempts were made.
 //
-// Thread-safety: next() from one thread (the capture thread). status(), requestStop() and releasing
-// a Frame's buffer_lease are safe from any thread. Leases may outlive the source.
+// A device node that does not exist at start (ENOENT, ENODEV, ENXIO) fails the constructor, unless
+// `wait_at_start` (URI `wait=1`; toposlamd's default, see registerV4l2FrameSourceScheme) is set: then
+// the source starts in the reconnecting state and opens the camera when it appears. Other start
+// failures (permissions, not a capture device, format not offered) always fail the constructor.
+//
+// Thread-safety: next()/nextFor() from one thread (the capture thread). status(), state(), interrupt()
+// and releasing a Frame's buffer_lease are safe from any thread. Leases may outlive the source.
 #pragma once
 
 #include <atomic>
@@ -56,21 +63,25 @@ struct V4l2SourceConfig {
   double fps = 30.0;  ///< requested frame rate (S_PARM); drivers without it ignore it
   V4l2PixelFormat format = V4l2PixelFormat::Yuyv;
   int buffer_count = 4;            ///< mmap buffers requested (REQBUFS), 2..32
-  int poll_timeout_ms = 200;       ///< one poll() slice; requestStop() is noticed within this time
+  int poll_timeout_ms = 200;       ///< longest poll() slice; interrupt() is noticed within this time
   int reconnect_initial_ms = 100;  ///< first backoff after an unplug, doubled per failed attempt
   int reconnect_max_ms = 2000;     ///< backoff ceiling
   int reconnect_max_attempts = 0;  ///< give up (FrameSourceError) after this many; 0 = never
+  bool wait_at_start = false;      ///< a missing device node at start: reconnect instead of failing
 
   /// "" or "<key>: <problem, allowed range>".
   std::string validate() const;
 };
 
-/// Parses "v4l2:/dev/videoN?size=WxH&fps=F&format=yuyv|mjpeg|grey|bgr24|rgb24&buffers=N" (all
-/// parameters optional). Throws FrameSourceError with the offending key on bad input.
-V4l2SourceConfig parseV4l2Uri(const std::string& uri);
+/// Parses "v4l2:/dev/videoN?size=WxH&fps=F&format=yuyv|mjpeg|grey|bgr24|rgb24&buffers=N&wait=0|1"
+/// (all parameters optional; `defaults` fills the rest). Throws FrameSourceError with the offending key
+/// on bad input.
+V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults = {});
 
 /// Registers the `v4l2:` scheme with openFrameSource() (io/source_factory.hpp). Call once at start-up.
-void registerV4l2FrameSourceScheme();
+/// `wait_at_start` is the default of the URI's `wait=`: the daemon waits for a missing camera, the
+/// command-line tools fail at once.
+void registerV4l2FrameSourceScheme(bool wait_at_start = false);
 
 /// What the daemon shows in its status. A consistent snapshot.
 struct V4l2SourceStatus {
@@ -96,15 +107,15 @@ struct V4l2SourceStatus {
 struct V4l2Runtime {
   /// Monotonic clock in seconds; default CLOCK_MONOTONIC (same clock as V4L2 buffer timestamps).
   std::function<double()> monotonic_s;
-  /// Waits before a reconnect attempt; default waits on a condition variable that requestStop()
-  /// interrupts.
+  /// Waits before a reconnect attempt (one slice of the backoff); default waits on a condition variable
+  /// that interrupt() wakes.
   std::function<void(std::chrono::milliseconds)> sleep;
 };
 
 class V4l2FrameSource : public FrameSource {
  public:
   /// Opens and starts the device; throws FrameSourceError with an actionable message if it cannot
-  /// (missing node, not a capture device, format not offered, no buffers).
+  /// (missing node unless wait_at_start, not a capture device, format not offered, no buffers).
   explicit V4l2FrameSource(V4l2SourceConfig config,
                            std::unique_ptr<V4l2Device> device = makeSystemV4l2Device(),
                            V4l2Runtime runtime = {});
@@ -113,22 +124,25 @@ class V4l2FrameSource : public FrameSource {
   V4l2FrameSource& operator=(const V4l2FrameSource&) = delete;
 
   std::string describe() const override;
-  /// Blocks until a frame arrives (reconnecting if needed). std::nullopt only after requestStop().
+  /// Blocks until a frame arrives (reconnecting if needed). std::nullopt only after interrupt().
   /// FrameSourceError when reconnecting gave up (reconnect_max_attempts).
   std::optional<Frame> next() override;
+  /// At most one poll slice (min(timeout, poll_timeout_ms)) or one backoff slice per call.
+  SourceWait nextFor(std::chrono::milliseconds timeout, Frame& out) override;
+  /// Makes a blocked or future next()/nextFor() end (within poll_timeout_ms). Any thread.
+  void interrupt() override;
+  FrameSourceState state() const override;
   std::int64_t skippedFrames() const override;
   std::int64_t droppedFrames() const;
   V4l2SourceStatus status() const;
-  /// Makes a blocked or future next() return std::nullopt. Any thread.
-  void requestStop();
 
   struct Stream;  // the open device, its buffers and the lock shared with leases (implementation)
 
  private:
-  void start();                          // open + negotiate + stream; throws FrameSourceError
+  bool start(bool absent_is_ok);         // open + negotiate + stream; false: node absent (and ok)
   void stop();                           // streamoff + close; outstanding leases stay valid
   void lose(const std::string& reason);  // device lost: stop and begin reconnecting
-  bool reconnectStep();                  // one backoff + attempt; true when streaming again
+  void reconnectSlice(std::chrono::milliseconds timeout);  // a slice of backoff, then maybe an attempt
   std::optional<Frame> handleBuffer(const ::v4l2_buffer& buffer);
   void requeue(std::uint32_t index);
   void waitFor(std::chrono::milliseconds delay);
@@ -154,6 +168,9 @@ class V4l2FrameSource : public FrameSource {
   std::uint32_t first_driver_sequence_ = 0;
   int buffers_this_stream_ = 0;     // buffers dequeued since STREAMON
   std::int64_t next_sequence_ = 0;  // one past the last delivered Frame::sequence
+
+  // Reconnecting: the backoff still to wait before the next attempt (-1: no attempt scheduled yet).
+  std::int64_t backoff_left_ms_ = -1;
 
   mutable std::mutex status_mutex_;
   V4l2SourceStatus status_;

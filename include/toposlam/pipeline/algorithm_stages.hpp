@@ -67,7 +67,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
   PlaceEstimate estimate() const override { return estimate_; }
   TopologySnapshot topology() const override { return topology_; }
-  void saveMap(const std::string& path) const override;
+  std::unique_ptr<const MapSnapshot> snapshotMap() const override;
 
   int observations() const { return filter_->observationCount(); }
 

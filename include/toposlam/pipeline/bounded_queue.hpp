@@ -4,6 +4,11 @@
 // refused, consumers drain what is left and then get "closed". Storage is a ring allocated once at
 // construction, so pushing and popping never allocate.
 //
+// Items that must never be dropped (records carrying a place) are named by an optional `must_keep`
+// predicate: push() then drops the oldest item that may be dropped, or the new item if only it may be;
+// when the queue is full of must-keep items and the new one must be kept too, push() waits for room
+// (counted in `kept_waits`).
+//
 // Thread-safety: every member may be called from any thread. A dropped item is destroyed outside the
 // lock (destroying a Frame may hand its buffer back to the source, which takes the source's lock).
 #pragma once
@@ -12,6 +17,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -27,6 +33,7 @@ struct QueueCounters {
   std::int64_t dropped = 0;  ///< items discarded because the queue was full (oldest first)
   std::int64_t popped = 0;   ///< items handed to a consumer
   std::int64_t refused = 0;  ///< pushes after close()
+  std::int64_t kept_waits = 0;  ///< pushes that waited because every item had to be kept
   std::size_t depth = 0;     ///< items waiting now
   std::size_t capacity = 0;
   std::size_t high_water = 0;  ///< largest depth seen
@@ -37,28 +44,43 @@ enum class QueueWait { Item, Timeout, Closed };
 template <typename T>
 class BoundedQueue {
  public:
-  explicit BoundedQueue(std::size_t capacity) : slots_(capacity) {
+  /// `must_keep` (optional): items push() may never drop. Called with the lock held; keep it cheap.
+  explicit BoundedQueue(std::size_t capacity, std::function<bool(const T&)> must_keep = {})
+      : slots_(capacity), must_keep_(std::move(must_keep)) {
     if (capacity == 0) throw std::invalid_argument("BoundedQueue: capacity must be >= 1");
   }
   BoundedQueue(const BoundedQueue&) = delete;
   BoundedQueue& operator=(const BoundedQueue&) = delete;
 
-  /// Enqueues `item`; if the queue is full the oldest item is dropped (and counted).
-  /// Returns false (and counts a refusal) if the queue is closed.
+  /// Enqueues `item`; if the queue is full the oldest droppable item is dropped (and counted), see
+  /// `must_keep` above. Returns false (and counts a refusal) if the queue is (or gets) closed.
   bool push(T item) {
     std::optional<T> evicted;  // destroyed after the lock is released
     {
-      std::lock_guard lock(mutex_);
+      std::unique_lock lock(mutex_);
       if (closed_) {
         ++counters_.refused;
         return false;
       }
       if (size_ == slots_.size()) {
-        evicted = std::move(slots_[head_]);
-        slots_[head_].reset();
-        head_ = (head_ + 1) % slots_.size();
-        --size_;
-        ++counters_.dropped;
+        std::size_t victim = 0;  // position from the head of the oldest droppable item
+        while (victim < size_ && mustKeep(*slots_[(head_ + victim) % slots_.size()])) ++victim;
+        if (victim < size_) {
+          evicted = removeLocked(victim);
+          ++counters_.dropped;
+        } else if (!mustKeep(item)) {
+          ++counters_.pushed;  // accepted and dropped at once: the newest is the only droppable one
+          ++counters_.dropped;
+          evicted = std::move(item);
+          return true;
+        } else {
+          ++counters_.kept_waits;
+          not_full_.wait(lock, [&] { return closed_ || size_ < slots_.size(); });
+          if (closed_) {
+            ++counters_.refused;
+            return false;
+          }
+        }
       }
       emplaceLocked(std::move(item));
     }
@@ -140,6 +162,20 @@ class BoundedQueue {
     if (size_ > counters_.high_water) counters_.high_water = size_;
   }
 
+  bool mustKeep(const T& item) const { return must_keep_ && must_keep_(item); }
+
+  /// Removes the item `position` places after the head, closing the gap (order is kept).
+  std::optional<T> removeLocked(std::size_t position) {
+    const std::size_t n = slots_.size();
+    std::optional<T> removed = std::move(slots_[(head_ + position) % n]);
+    for (std::size_t i = position; i > 0; --i)  // shift the older items one place towards the tail
+      slots_[(head_ + i) % n] = std::move(slots_[(head_ + i - 1) % n]);
+    slots_[head_].reset();
+    head_ = (head_ + 1) % n;
+    --size_;
+    return removed;
+  }
+
   std::optional<T> takeLocked(std::unique_lock<std::mutex>& lock) {
     if (size_ == 0) return std::nullopt;  // closed and drained
     std::optional<T> item = std::move(slots_[head_]);
@@ -160,6 +196,7 @@ class BoundedQueue {
   std::size_t size_ = 0;
   bool closed_ = false;
   QueueCounters counters_;
+  std::function<bool(const T&)> must_keep_;
 };
 
 }  // namespace toposlam

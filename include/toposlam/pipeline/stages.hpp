@@ -102,6 +102,18 @@ class SegmentationStage {
                                    const cv::Mat& thumbnail) = 0;
 };
 
+/// A copy of the map taken at one moment (in memory, cheap), written to disk later by another thread so
+/// the fsync never stalls the frame path.
+class MapSnapshot {
+ public:
+  virtual ~MapSnapshot() = default;
+  /// Replaces the map file at `path` atomically (readers and a crash see the old or the new map, never
+  /// half of one). Throws std::runtime_error (or a subclass) on I/O failure. Any thread.
+  virtual void writeTo(const std::string& path) const = 0;
+  /// Size of the file image in bytes (for the log).
+  virtual std::size_t bytes() const = 0;
+};
+
 /// The topology filter, with its per-place step split into bounded slices of work.
 class TopologyStage {
  public:
@@ -117,9 +129,9 @@ class TopologyStage {
   virtual PlaceEstimate estimate() const = 0;
   /// The most probable topology as of the last finished step.
   virtual TopologySnapshot topology() const = 0;
-  /// Replaces the map file at `path` atomically (readers and a crash see the old or the new map, never
-  /// half of one). Only called when idle(). Throws std::runtime_error (or a subclass) on I/O failure.
-  virtual void saveMap(const std::string& path) const = 0;
+  /// The map as it is now, to be written by MapSnapshot::writeTo() from any thread. Only called when
+  /// idle(). Throws std::runtime_error (or a subclass) if the map cannot be encoded.
+  virtual std::unique_ptr<const MapSnapshot> snapshotMap() const = 0;
 };
 
 // ---------------------------------------------------------------------------------------------------
@@ -148,8 +160,12 @@ struct PipelineStatus {
   double fps = 0.0;             ///< frames published per second over the last period
   std::int64_t frames_captured = 0;
   std::int64_t frames_published = 0;
-  std::int64_t frames_dropped = 0;   ///< all queues together
+  std::int64_t frames_dropped = 0;   ///< all queues together (only per-frame estimates; places are kept)
   std::int64_t source_skipped = 0;   ///< bad frames the source skipped
+  SourceLink source_link = SourceLink::Streaming;  ///< the camera: streaming or reconnecting
+  std::int64_t source_reconnects = 0;              ///< camera outages survived
+  int source_reconnect_attempts = 0;               ///< failed attempts in the current outage
+  std::int64_t source_dropped = 0;                 ///< frames the driver lost (sequence gaps)
   LatencyStats latency;              ///< capture to publish, last period
   std::vector<StageStatus> stages;   ///< capture, fingerprint, segmentation, topology, publisher
   double cpu_percent = 0.0;          ///< whole process, last period (100 = one core)

@@ -71,7 +71,7 @@ void runCapture(const CaptureOptions& options) {
   if (options.uri.rfind("v4l2:", 0) == 0) {
     auto v4l2 = std::make_unique<V4l2FrameSource>(parseV4l2Uri(options.uri));
     V4l2FrameSource* raw = v4l2.get();
-    request_stop = [raw] { raw->requestStop(); };
+    request_stop = [raw] { raw->interrupt(); };
     reconnects = [raw] { return raw->status().reconnects; };
     dropped = [raw] { return raw->droppedFrames(); };
     source = std::move(v4l2);
@@ -79,7 +79,7 @@ void runCapture(const CaptureOptions& options) {
 #ifdef TOPOSLAM_HAVE_LIBCAMERA
     auto camera = std::make_unique<LibcameraFrameSource>(parseLibcameraUri(options.uri));
     LibcameraFrameSource* raw = camera.get();
-    request_stop = [raw] { raw->requestStop(); };
+    request_stop = [raw] { raw->interrupt(); };
     dropped = [raw] { return raw->droppedFrames(); };
     source = std::move(camera);
 #else

@@ -61,14 +61,6 @@ LcmChannels channelsOf(const LcmSettings& lcm) {
   return c;
 }
 
-std::string statusLine(const PipelineStatus& s) {
-  char text[256];
-  std::snprintf(text, sizeof text, "%s: %.1f fps, latency p99 %.1f ms, %d places, map rev %lld, %lld dropped",
-                s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
-                static_cast<long long>(s.frames_dropped));
-  return text;
-}
-
 /// Everything one run needs, built from the config in dependency order.
 struct Assembly {
   std::unique_ptr<FrameSource> source;
@@ -166,7 +158,7 @@ int runDaemon(const DaemonConfig& config) {
       pipeline.requestStop();
     }
     if (watchdog_s > 0 && pipeline.healthy()) notifier.watchdog();
-    if (!stopping) notifier.status(statusLine(pipeline.status()));
+    if (!stopping) notifier.status(statusLine(pipeline.status()));  // says when the camera is reconnecting
   }
   pipeline.wait();
   receiving.store(false);

@@ -1,5 +1,6 @@
 // See sources.hpp. The camera adapters register their URI schemes (v4l2:, libcamera:) once, before the
-// first source is opened.
+// first source is opened. A V4L2 camera that is not plugged in yet does not stop the service: it starts
+// reconnecting (status "camera reconnecting") and opens the camera when it appears (URI wait=0 opts out).
 #include "sources.hpp"
 
 #include <mutex>
@@ -21,7 +22,7 @@ std::unique_ptr<FrameSource> openSource(const std::string& uri) {
   static std::once_flag registered;
   std::call_once(registered, [] {
 #ifdef TOPOSLAM_HAVE_V4L2
-    registerV4l2FrameSourceScheme();
+    registerV4l2FrameSourceScheme(/*wait_at_start=*/true);
 #endif
 #ifdef TOPOSLAM_HAVE_LIBCAMERA
     registerLibcameraFrameSourceScheme();
