@@ -66,6 +66,11 @@ std::string FiedlerSegmenterConfig::validate() const {
     return "window: " + std::to_string(window) + " frames is outside the allowed range [3, 1000]";
   }
   if (std::string problem = valley.validate(maxFiedlerValue(window)); !problem.empty()) return problem;
+  if (!(similarity_floor >= 0.0 && similarity_floor < 1.0)) {
+    std::ostringstream message;
+    message << "similarity_floor: " << similarity_floor << " is outside the allowed range [0, 1)";
+    return message.str();
+  }
   if (min_keypoints < 0 || min_keypoints > 100000) {
     return "min_keypoints: " + std::to_string(min_keypoints) + " is outside the allowed range [0, 100000]";
   }
@@ -156,10 +161,7 @@ void FiedlerSegmenter::compactCandidates() {
   }
   const Candidate* best = nullptr;
   for (const Candidate& c : candidates_) {
-    if (c.frame < bound &&
-        (best == nullptr || c.degree > best->degree || (c.degree == best->degree && c.frame < best->frame))) {
-      best = &c;
-    }
+    if (c.frame < bound && (best == nullptr || preferred(c, *best))) best = &c;
   }
   if (best == nullptr) return;
   const std::int64_t keep = best->frame;
@@ -167,17 +169,24 @@ void FiedlerSegmenter::compactCandidates() {
 }
 
 void FiedlerSegmenter::rememberBestWindowFrame(std::int64_t from_frame, std::int64_t before_frame) {
-  int best_slot = -1;
+  std::optional<Candidate> best;
   for (int position = 0; position < count_; ++position) {
     const int slot = slotAtPosition(position);
-    const std::int64_t frame = slot_frame_[static_cast<std::size_t>(slot)];
+    const auto s = static_cast<std::size_t>(slot);
+    const std::int64_t frame = slot_frame_[s];
     if (frame < from_frame || frame >= before_frame) continue;
-    // Strictly larger: on ties the oldest frame wins (positions run oldest first).
-    if (best_slot < 0 || degree_(slot) > degree_(best_slot)) best_slot = slot;
+    Candidate candidate{frame, degree_(slot), slot_time_[s], slot_fingerprint_[s], slot_fingerprint_[s]->keypointCount()};
+    if (!best || preferred(candidate, *best)) best = std::move(candidate);
   }
-  if (best_slot < 0) return;
-  const auto s = static_cast<std::size_t>(best_slot);
-  addCandidate(Candidate{slot_frame_[s], degree_(best_slot), slot_time_[s], slot_fingerprint_[s]});
+  if (best) addCandidate(*best);
+}
+
+bool FiedlerSegmenter::preferred(const Candidate& a, const Candidate& b) const {
+  const bool a_rich = a.keypoints >= config_.min_keypoints;
+  const bool b_rich = b.keypoints >= config_.min_keypoints;
+  if (a_rich != b_rich) return a_rich;
+  if (a.degree != b.degree) return a.degree > b.degree;
+  return a.frame < b.frame;
 }
 
 int FiedlerSegmenter::bestSplitPosition() const {
@@ -241,6 +250,7 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
     if (occupied_before == n || other < occupied_before) {
       value = sanitizeSimilarity(similarity_.symmetricSimilarity(
           *slot_fingerprint_[static_cast<std::size_t>(other)], *slot_fingerprint_[s]));
+      value = std::max(0.0, value - config_.similarity_floor);
     }
     affinity_(slot, other) = value;
     affinity_(other, slot) = value;
@@ -314,15 +324,13 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
   const Candidate* best = nullptr;
   for (const Candidate& c : candidates_) {
     if (c.frame < place_start_ || c.frame > last_frame) continue;
-    if (best == nullptr || c.degree > best->degree || (c.degree == best->degree && c.frame < best->frame)) {
-      best = &c;
-    }
+    if (best == nullptr || preferred(c, *best)) best = &c;
   }
   if (best != nullptr) {
     place.representative_frame = best->frame;
     place.representative_degree = best->degree;
     place.representative = best->fingerprint;
-    place.representative_keypoints = best->fingerprint ? best->fingerprint->keypointCount() : 0;
+    place.representative_keypoints = best->keypoints;
   }
   place.dropped = place.representative_keypoints < config_.min_keypoints;
   place.index = place.dropped ? dropped_places_++ : kept_places_++;

@@ -11,6 +11,7 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
 
 namespace toposlam::test {
 
@@ -19,6 +20,15 @@ inline std::shared_ptr<const Fingerprint> fakeFingerprint(int id, int keypoints 
   fingerprint->image_width = id;
   fingerprint->keypoints.resize(static_cast<std::size_t>(keypoints));
   return fingerprint;
+}
+
+/// The thesis' segmentation settings (window 25, gamma 0.5, delta 0.25), which the hand-made streams
+/// check the thesis' numbers with; our defaults differ (docs/segmentation.md).
+inline FiedlerSegmenterConfig thesisConfig() {
+  FiedlerSegmenterConfig config;
+  config.window = 25;
+  config.valley = {0.5, 0.25};
+  return config;
 }
 
 /// similarity(reference, query) = table(reference id, query id).

@@ -15,6 +15,7 @@ using toposlam::FiedlerSegmenterConfig;
 using toposlam::SegmentedPlace;
 using toposlam::test::fakeFingerprint;
 using toposlam::test::TableSimilarity;
+using toposlam::test::thesisConfig;
 
 namespace {
 
@@ -125,7 +126,7 @@ TEST_CASE(
     "GIVEN identical frames streaming in WHEN each is added THEN lambda2 follows k/(k-1) and reaches 25/24",
     "[segmentation][segmenter]") {
   TableSimilarity similarity([](int, int) { return 0.9; });
-  FiedlerSegmenter segmenter({}, similarity);
+  FiedlerSegmenter segmenter(thesisConfig(), similarity);
   const Run run = runStream(segmenter, 40);
   CHECK_FALSE(run.lambda2[0].has_value());
   REQUIRE(run.lambda2[1].has_value());
@@ -147,7 +148,7 @@ TEST_CASE(
     "GIVEN a window of n frames WHEN a new frame arrives THEN only its 2(n-1) similarities are computed",
     "[segmentation][segmenter]") {
   TableSimilarity similarity([](int a, int b) { return a == b ? 1.0 : 0.5; });
-  FiedlerSegmenterConfig config;
+  FiedlerSegmenterConfig config = thesisConfig();
   config.window = 25;
   FiedlerSegmenter segmenter(config, similarity);
   for (int f = 0; f < 60; ++f) {
@@ -170,7 +171,7 @@ TEST_CASE(
     "GIVEN an asymmetric similarity WHEN frames are added THEN the affinity is the mean of both directions",
     "[segmentation][segmenter]") {
   TableSimilarity similarity([](int reference, int query) { return reference < query ? 0.2 : 0.6; });
-  FiedlerSegmenter segmenter({}, similarity);
+  FiedlerSegmenter segmenter(thesisConfig(), similarity);
   for (int f = 0; f < 3; ++f) segmenter.addFrame(f, 0.0, fakeFingerprint(f));
   const Eigen::MatrixXd a = segmenter.affinityInWindowOrder();
   CHECK(a(0, 1) == Approx(0.4));
@@ -186,7 +187,7 @@ TEST_CASE(
   TableSimilarity similarity([&](int a, int b) { return blockSimilarity(labels, a, b); });
 
   SECTION("window-split (default): exactly at the borders 40, 75 and 120") {
-    FiedlerSegmenter segmenter({}, similarity);
+    FiedlerSegmenter segmenter(thesisConfig(), similarity);
     const Run run = runStream(segmenter, static_cast<int>(labels.size()));
     REQUIRE(run.places.size() == 4);
     const std::vector<std::pair<std::int64_t, std::int64_t>> expected = {
@@ -214,7 +215,7 @@ TEST_CASE(
     }
   }
   SECTION("valley-frame (Algorithm 4.1 read literally): each place ends at the valley frame") {
-    FiedlerSegmenterConfig config;
+    FiedlerSegmenterConfig config = thesisConfig();
     config.cut_placement = CutPlacement::ValleyFrame;
     FiedlerSegmenter segmenter(config, similarity);
     const Run run = runStream(segmenter, static_cast<int>(labels.size()));
@@ -246,7 +247,7 @@ TEST_CASE(
     if (labels[static_cast<std::size_t>(a)] != labels[static_cast<std::size_t>(b)]) return 0.05;
     return 0.8 + quality(a) + quality(b) + 0.01 * std::sin(0.7 * a + 1.3 * b);
   });
-  FiedlerSegmenter segmenter({}, similarity);
+  FiedlerSegmenter segmenter(thesisConfig(), similarity);
   const Run run = runStream(segmenter, 150);
   REQUIRE(run.places.size() == 3);
   for (std::size_t i = 0; i < 3; ++i) {
@@ -263,7 +264,7 @@ TEST_CASE("GIVEN a block whose frames have few keypoints WHEN segmented THEN its
           "[segmentation][segmenter]") {
   const std::vector<int> labels = blockLabels({40, 40, 40});
   TableSimilarity similarity([&](int a, int b) { return blockSimilarity(labels, a, b); });
-  FiedlerSegmenterConfig config;
+  FiedlerSegmenterConfig config = thesisConfig();
   config.min_keypoints = 15;
   FiedlerSegmenter segmenter(config, similarity);
   const Run run =
@@ -281,10 +282,76 @@ TEST_CASE("GIVEN a block whose frames have few keypoints WHEN segmented THEN its
 }
 
 TEST_CASE(
+    "GIVEN a block whose most similar frame has too few keypoints WHEN segmented THEN a keypoint-rich member "
+    "represents it and the place is kept",
+    "[segmentation][segmenter]") {
+  // Block 1's most similar frame (71, a bare doorway view) has 3 keypoints; frame 64 is the most similar
+  // of the keypoint-rich ones. The thesis' rule would pick 71 and drop the place.
+  const std::vector<int> labels = blockLabels({50, 50, 50});
+  auto quality = [](int f) { return f == 71 ? 0.1 : f == 64 ? 0.05 : 0.0; };
+  TableSimilarity similarity([&](int a, int b) {
+    if (labels[static_cast<std::size_t>(a)] != labels[static_cast<std::size_t>(b)]) return 0.05;
+    return 0.8 + quality(a) + quality(b) + 0.01 * std::sin(0.7 * a + 1.3 * b);
+  });
+  FiedlerSegmenter segmenter(thesisConfig(), similarity);
+  const Run run = runStream(segmenter, 150, [](int f) { return f == 71 ? 3 : 40; });
+  REQUIRE(run.places.size() == 3);
+  CHECK_FALSE(run.places[1].dropped);
+  CHECK(run.places[1].representative_frame == 64);
+  CHECK(run.places[1].representative_keypoints == 40);
+  WHEN("no member has enough keypoints") {
+    FiedlerSegmenter poor(thesisConfig(), similarity);
+    const Run dropped = runStream(poor, 150, [&](int f) { return labels[static_cast<std::size_t>(f)] == 1 ? 3 : 40; });
+    REQUIRE(dropped.places.size() == 3);
+    THEN("the most similar frame represents it and the place is dropped") {
+      CHECK(dropped.places[1].dropped);
+      CHECK(dropped.places[1].representative_frame == 71);
+    }
+  }
+}
+
+TEST_CASE(
+    "GIVEN blocks that still match about 0.3 across borders WHEN a similarity floor of 0.3 is subtracted THEN "
+    "the valleys of lambda2 deepen towards 0 and the cuts stay at the borders",
+    "[segmentation][segmenter]") {
+  const std::vector<int> labels = blockLabels({40, 35, 45});
+  TableSimilarity similarity([&](int a, int b) {
+    if (labels[static_cast<std::size_t>(a)] != labels[static_cast<std::size_t>(b)])
+      return 0.32 + 0.02 * std::sin(1.1 * a + 0.4 * b);
+    return 0.9 + 0.05 * std::sin(0.7 * a + 1.3 * b);
+  });
+  FiedlerSegmenterConfig plain;
+  FiedlerSegmenterConfig floored;
+  floored.similarity_floor = 0.3;
+  FiedlerSegmenter without_floor(plain, similarity);
+  FiedlerSegmenter with_floor(floored, similarity);
+  const Run a = runStream(without_floor, 120);
+  const Run b = runStream(with_floor, 120);
+  double min_a = 10.0, min_b = 10.0;
+  for (std::size_t f = 24; f < 120; ++f) {
+    min_a = std::min(min_a, *a.lambda2[f]);
+    min_b = std::min(min_b, *b.lambda2[f]);
+  }
+  INFO("lowest lambda2 without the floor " << min_a << ", with it " << min_b);
+  CHECK(min_a > 0.3);   // ~0.32 across and ~0.9 inside: the split window stays well connected
+  CHECK(min_b < 0.1);   // floored: 0 .. 0.04 across, a split window is nearly disconnected
+  REQUIRE(b.places.size() == 3);
+  CHECK(b.places[1].first_frame == 40);
+  CHECK(b.places[2].first_frame == 75);
+  THEN("a floor outside [0, 1) is refused by name") {
+    FiedlerSegmenterConfig bad;
+    bad.similarity_floor = 1.0;
+    CHECK_THAT(bad.validate(), Catch::StartsWith("similarity_floor:"));
+    bad.similarity_floor = -0.1;
+    CHECK_THAT(bad.validate(), Catch::StartsWith("similarity_floor:"));
+  }
+}
+
+TEST_CASE(
     "GIVEN all-zero similarities WHEN segmented THEN lambda2 is 0, nothing is cut, flush closes one place",
     "[segmentation][segmenter]") {
   TableSimilarity similarity([](int, int) { return 0.0; });
-  FiedlerSegmenter segmenter({}, similarity);
+  FiedlerSegmenter segmenter(thesisConfig(), similarity);
   const Run run = runStream(segmenter, 30);
   for (std::size_t f = 1; f < 30; ++f) CHECK(*run.lambda2[f] == 0.0);
   REQUIRE(run.places.size() == 1);
@@ -296,7 +363,7 @@ TEST_CASE(
 TEST_CASE("GIVEN flush WHEN called on an empty segmenter or twice THEN it closes at most one place",
           "[segmentation][segmenter]") {
   TableSimilarity similarity([](int, int) { return 0.7; });
-  FiedlerSegmenter segmenter({}, similarity);
+  FiedlerSegmenter segmenter(thesisConfig(), similarity);
   CHECK_FALSE(segmenter.flush().has_value());
   segmenter.addFrame(0, 0.0, fakeFingerprint(0));
   auto only = segmenter.flush();
@@ -320,7 +387,7 @@ TEST_CASE("GIVEN flush WHEN called on an empty segmenter or twice THEN it closes
 TEST_CASE("GIVEN bad input WHEN added THEN it is refused with a clear message", "[segmentation][segmenter]") {
   TableSimilarity similarity([](int, int) { return 0.7; });
   SECTION("invalid configs name the key") {
-    FiedlerSegmenterConfig config;
+    FiedlerSegmenterConfig config = thesisConfig();
     config.window = 2;
     CHECK_THROWS_WITH(FiedlerSegmenter(config, similarity), Catch::Contains("window"));
     config = {};
@@ -331,7 +398,7 @@ TEST_CASE("GIVEN bad input WHEN added THEN it is refused with a clear message", 
     CHECK_THROWS_WITH(FiedlerSegmenter(config, similarity), Catch::Contains("min_keypoints"));
   }
   SECTION("frame indices must increase; fingerprints must not be null") {
-    FiedlerSegmenter segmenter({}, similarity);
+    FiedlerSegmenter segmenter(thesisConfig(), similarity);
     segmenter.addFrame(3, 0.0, fakeFingerprint(3));
     CHECK_THROWS_WITH(segmenter.addFrame(3, 0.0, fakeFingerprint(3)), Catch::Contains("increase"));
     CHECK_THROWS_WITH(segmenter.addFrame(4, 0.0, nullptr), Catch::Contains("null"));

@@ -39,15 +39,16 @@ TEST_CASE(
   const toposlam::NgramSimilarity similarity;
 
   SECTION(
-      "window 25 (thesis default): the window spans half the loop, lambda2 stays in [0.55, 0.95], one "
-      "place") {
+      "default window (30 frames, 30 s here): the window spans three quarters of the 40-frame lap, lambda2 "
+      "stays in [0.55, 0.95], one place") {
+    REQUIRE(toposlam::FiedlerSegmenterConfig{}.window == 30);
     toposlam::OfflineSegmentation pipeline(extractor, similarity, {});
     for (std::size_t i = 0; i < frames.size(); ++i)
       pipeline.process(frames[i], static_cast<double>(i), std::to_string(i + 1) + ".jpg");
     pipeline.finish();
     const toposlam::SegmentationRun& run = pipeline.run();
     REQUIRE(run.frames.size() == 84);
-    for (std::size_t i = 24; i < 84; ++i) {
+    for (std::size_t i = 29; i < 84; ++i) {
       REQUIRE(run.frames[i].lambda2.has_value());
       CHECK(*run.frames[i].lambda2 > 0.55);
       CHECK(*run.frames[i].lambda2 < 0.95);
@@ -59,31 +60,23 @@ TEST_CASE(
     CHECK(run.places[0].representative_keypoints >= 15);
     CHECK(run.frames[50].place == 0);
   }
-  SECTION("window 5 (about 5 m of travel at 1 Hz): a handful of places, repeated on the second lap") {
+  SECTION("window 5 (5 s at 1 Hz, the thesis' 25 frames at 5 fps): six places, a border repeated a lap later") {
     toposlam::FiedlerSegmenterConfig config;
     config.window = 5;
     toposlam::OfflineSegmentation pipeline(extractor, similarity, config);
     for (std::size_t i = 0; i < frames.size(); ++i) pipeline.process(frames[i], static_cast<double>(i));
     pipeline.finish();
     const toposlam::SegmentationRun& run = pipeline.run();
-    const std::size_t places = run.places.size() + run.dropped_places.size();
     INFO("places " << run.places.size() << " dropped " << run.dropped_places.size());
-    CHECK(places >= 4);
-    CHECK(places <= 10);
-    // Measured: borders at frames 10, 18, 25, 48, 59; the lap is about 41 frames, and 18 + 41 = 59.
+    CHECK(run.places.size() == 6);
+    CHECK(run.dropped_places.empty());
+    // Measured: borders at frames 10, 18, 25, 48, 59; the lap is 40 frames (samples_GT: frame i + 40
+    // revisits frame i), and 18 + 41 = 59.
     std::vector<std::int64_t> borders;
     for (const auto& p : run.places)
       if (p.valley_frame >= 0) borders.push_back(p.last_frame + 1);
-    for (const auto& p : run.dropped_places)
-      if (p.valley_frame >= 0) borders.push_back(p.last_frame + 1);
     std::sort(borders.begin(), borders.end());
-    int repeated = 0;
-    for (std::int64_t b : borders) {
-      for (std::int64_t c : borders) {
-        if (c - b >= 38 && c - b <= 44) ++repeated;
-      }
-    }
-    CHECK(repeated >= 1);
+    CHECK(borders == std::vector<std::int64_t>{10, 18, 25, 48, 59});
   }
 }
 
@@ -103,7 +96,10 @@ const SimRun& simulatedOfficeRun() {
     toposlam::sim::Simulator simulator(sim_config);
     const toposlam::VpackExtractor extractor;
     const toposlam::NgramSimilarity similarity;
-    toposlam::OfflineSegmentation pipeline(extractor, similarity, {});
+    toposlam::FiedlerSegmenterConfig thesis;  // window 25, gamma 0.5, delta 0.25
+    thesis.window = 25;
+    thesis.valley = {0.5, 0.25};
+    toposlam::OfflineSegmentation pipeline(extractor, similarity, thesis);
     SimRun result;
     while (auto frame = simulator.next()) {
       pipeline.process(frame->image, frame->truth.time_s);

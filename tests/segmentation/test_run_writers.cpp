@@ -13,6 +13,7 @@
 
 using toposlam::test::fakeFingerprint;
 using toposlam::test::TableSimilarity;
+using toposlam::test::thesisConfig;
 
 namespace {
 
@@ -32,7 +33,7 @@ TEST_CASE(
   auto block = [](int f) { return f < 40 ? 0 : (f < 80 ? 1 : 2); };
   TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
   const toposlam::VpackExtractor extractor;  // unused: fingerprints are given
-  toposlam::OfflineSegmentation pipeline(extractor, similarity, {});
+  toposlam::OfflineSegmentation pipeline(extractor, similarity, thesisConfig());
   for (int f = 0; f < 120; ++f) {
     std::string name = "f";
     name.append(std::to_string(f)).append(".png");

@@ -21,12 +21,15 @@
 // (the sparsest cut the Fiedler vector approximates, restricted to splits in time). ValleyFrame is the
 // literal reading of Algorithm 4.1: the place ends at the valley frame itself.
 //
-// Representative (section 4.2.3): after every frame, the window frame (of the open place) with the
-// largest degree is remembered with that degree; when a place closes, its representative is the
-// remembered candidate with the largest degree inside the place (ties: the earliest frame). So that a
+// Representative (section 4.2.3): after every frame, the preferred window frame (of the open place) is
+// remembered with its degree; when a place closes, its representative is the preferred remembered
+// candidate inside the place. Preferred means: a frame with at least `min_keypoints` keypoints beats
+// one with fewer (a featureless doorway view matches everything by colour and so often has the largest
+// degree, but it would get the place dropped); then the larger degree; then the earlier frame. So that a
 // short place always has a candidate, the moment the detector records a new lambda2 minimum (the
 // future border) also remembers the best window frame before that border. A place whose
-// representative has fewer than `min_keypoints` keypoints is reported as dropped. Candidates older than
+// representative has fewer than `min_keypoints` keypoints (no member had enough) is reported as
+// dropped. Candidates older than
 // any possible future border all fall in the open place, so only their best is kept: memory stays
 // O(window) except while a valley candidate waits for confirmation.
 //
@@ -58,10 +61,15 @@ const char* toString(CutPlacement placement);
 CutPlacement parseCutPlacement(const std::string& name);
 
 struct FiedlerSegmenterConfig {
-  int window = 25;  ///< frames in the sliding window (thesis: 25; allowed [3, 1000])
-  /// Peak/valley thresholds on lambda2. Thesis: gamma 0.5, delta 0.25 (see docs/segmentation.md for
-  /// how they relate to our similarity scale).
-  ValleyDetectorConfig valley;
+  /// Frames in the sliding window; allowed [3, 1000]. Thesis: 25 (at ~5 fps). Our default, 30 with
+  /// delta 0.30, was chosen by measurement on the simulated routes (docs/segmentation.md, "Defaults").
+  int window = 30;
+  /// Subtracted from every similarity before it enters the affinity matrix (clamped at 0), so frames
+  /// of different places, which still match ~0.15 by colour, become unlinked. Allowed [0, 1).
+  double similarity_floor = 0.0;
+  /// Peak/valley thresholds on lambda2. Thesis: gamma 0.5, delta 0.25; ours gamma 0.5, delta 0.30 (see
+  /// docs/segmentation.md for how they relate to our similarity scale).
+  ValleyDetectorConfig valley{0.5, 0.30};
   int min_keypoints = 15;  ///< places whose representative has fewer keypoints are dropped (thesis: 15)
   CutPlacement cut_placement = CutPlacement::WindowSplit;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
@@ -128,7 +136,10 @@ class FiedlerSegmenter {
     double degree;
     double time_s;
     std::shared_ptr<const Fingerprint> fingerprint;
+    int keypoints;
   };
+  /// The representative preference of the header comment: true when `a` is the better candidate.
+  bool preferred(const Candidate& a, const Candidate& b) const;
 
   int slotAtPosition(int position) const;  ///< window position 0 = oldest frame
   double computeLambda2();

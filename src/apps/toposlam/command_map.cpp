@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "offline_run_io.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -34,13 +35,9 @@
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
-#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/segmentation/offline_mapper.hpp"
 #include "toposlam/topology/map_store.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
-
-#ifdef TOPOSLAM_HAVE_SOURCES
-#include "toposlam/io/source_factory.hpp"
-#endif
 
 namespace toposlam::cli {
 
@@ -57,17 +54,8 @@ struct MapOptions {
   int max_representatives = 8;
   std::string resume;
   std::string keypoints = "orb";
+  SegmentationOptions segmentation;
 };
-
-std::unique_ptr<FrameSource> openSource(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
-  return openFrameSource(uri);
-#else
-  throw FrameSourceError("cannot open '" + uri +
-                         "': this build has no frame sources (toposlam_sources was not "
-                         "built; see io/source_factory.hpp)");
-#endif
-}
 
 /// Per observation of the map (this run's and earlier runs'): where it came from.
 struct ObservationOrigin {
@@ -96,15 +84,6 @@ std::vector<ObservationOrigin> decodeOrigins(const std::string& text, int observ
   return origins;
 }
 
-struct StepRow {
-  std::int64_t place = 0;  ///< kept place of this run
-  TopologyEstimate estimate;
-};
-
-struct FrameTiming {
-  double fingerprint_ms = 0.0, segment_ms = 0.0, filter_ms = 0.0;
-};
-
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -115,47 +94,16 @@ std::string shellQuote(const std::string& text) {
   return out + "'";
 }
 
-std::ofstream openOutput(const fs::path& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw std::runtime_error(path.string() + ": cannot create file (is the folder writable?)");
-  return out;
-}
-
-/// Appends one source's segmentation to the run of all sources, renumbering frames and places.
-void appendRun(SegmentationRun& all, const SegmentationRun& part) {
-  const auto frame_offset = static_cast<std::int64_t>(all.frames.size());
-  const auto kept_offset = static_cast<std::int64_t>(all.places.size());
-  const auto dropped_offset = static_cast<std::int64_t>(all.dropped_places.size());
-  for (SegmentationFrameRecord f : part.frames) {
-    f.frame += frame_offset;
-    if (f.place >= 0) f.place += kept_offset;
-    all.frames.push_back(std::move(f));
-  }
-  auto shift = [&](SegmentedPlace p, std::int64_t index_offset) {
-    p.first_frame += frame_offset;
-    p.last_frame += frame_offset;
-    p.representative_frame += frame_offset;
-    if (p.valley_frame >= 0) p.valley_frame += frame_offset;
-    p.index += index_offset;
-    p.representative.reset();  // the filter keeps what it needs
-    return p;
-  };
-  for (const SegmentedPlace& p : part.places) all.places.push_back(shift(p, kept_offset));
-  for (const SegmentedPlace& p : part.dropped_places) all.dropped_places.push_back(shift(p, dropped_offset));
-}
-
 void runMap(const MapOptions& o, bool filter_options_given) {
   if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
+  const FiedlerSegmenterConfig segmenter_config = segmenterConfig(o.segmentation, "map");
   const fs::path out_dir(o.out);
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (!fs::is_directory(out_dir)) throw std::runtime_error(o.out + ": cannot create the output folder");
+  createRunFolder(o.out);
 
   VpackConfig vpack;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   const VpackExtractor extractor(vpack);
   const NgramSimilarity similarity;
-  const FiedlerSegmenterConfig segmenter_config;
 
   std::unique_ptr<TopologyParticleFilter> filter;
   std::vector<ObservationOrigin> origins;
@@ -183,40 +131,34 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   }
   const int first_observation = filter->observationCount();
 
-  SegmentationRun all;
+  OfflineMapper mapper(extractor, similarity, segmenter_config, *filter);
   std::vector<FrameTiming> timing;
-  std::vector<StepRow> steps;
   std::int64_t refused = 0;
+
+  auto mapPlace = [&](const SegmentedPlace& place) {
+    if (place.dropped) return;
+    const auto start = std::chrono::steady_clock::now();
+    const MappedPlace mapped = *mapper.mapPlace(place);
+    if (!timing.empty()) timing.back().filter_ms = *timing.back().filter_ms + msSince(start);
+    origins.push_back(ObservationOrigin{run_number, place.representative_frame});
+    const TopologyEstimate& e = mapped.estimate;
+    std::fprintf(stderr, "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
+                 static_cast<long long>(place.index), static_cast<long long>(place.first_frame),
+                 static_cast<long long>(place.last_frame), e.current_node, e.current_node_probability,
+                 e.best.probability, e.effective_sample_size);
+  };
 
   for (const std::string& uri : o.sources) {
     std::unique_ptr<FrameSource> source = openSource(uri);
     std::cerr << "map: " << source->describe() << "\n";
-    OfflineSegmentation pipeline(extractor, similarity, segmenter_config);  // fresh window per traversal
-    const auto kept_offset = static_cast<std::int64_t>(all.places.size());
-    const auto frame_offset = static_cast<std::int64_t>(all.frames.size());
-
-    auto mapPlace = [&](const SegmentedPlace& place) {
-      if (place.dropped) return;
-      const auto start = std::chrono::steady_clock::now();
-      filter->step(place.representative);
-      if (!timing.empty()) timing.back().filter_ms += msSince(start);
-      origins.push_back(ObservationOrigin{run_number, frame_offset + place.representative_frame});
-      steps.push_back(StepRow{kept_offset + place.index, filter->estimate(3)});
-      const TopologyEstimate& e = steps.back().estimate;
-      std::fprintf(stderr,
-                   "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
-                   static_cast<long long>(kept_offset + place.index),
-                   static_cast<long long>(frame_offset + place.first_frame),
-                   static_cast<long long>(frame_offset + place.last_frame), e.current_node,
-                   e.current_node_probability, e.best.probability, e.effective_sample_size);
-    };
-
+    mapper.beginTraversal();  // fresh segmentation window per traversal
     while (std::optional<Frame> frame = source->next()) {
       FrameTiming t;
+      t.filter_ms = 0.0;
       auto start = std::chrono::steady_clock::now();
       std::shared_ptr<const Fingerprint> fingerprint;
       try {
-        fingerprint = pipeline.fingerprint(frame->image);
+        fingerprint = mapper.fingerprint(frame->image);
       } catch (const std::invalid_argument& e) {
         // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
         if (refused++ == 0) std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
@@ -224,17 +166,17 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       }
       t.fingerprint_ms = msSince(start);
       start = std::chrono::steady_clock::now();
-      const SegmenterStep step = pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
+      const SegmenterStep step = mapper.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
       if (step.closed_place) mapPlace(*step.closed_place);
     }
-    if (auto last = pipeline.finish()) mapPlace(*last);
+    if (auto last = mapper.finishTraversal()) mapPlace(*last);
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
-    appendRun(all, pipeline.run());
   }
+  const SegmentationRun all = mapper.run();
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
                              " refused)");
@@ -242,10 +184,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter->estimate(3);
   const std::vector<int>& assignment = final_estimate.best.assignment;
-  std::vector<std::int64_t> place_nodes;
-  for (std::size_t p = 0; p < all.places.size(); ++p) {
-    place_nodes.push_back(assignment[static_cast<std::size_t>(first_observation) + p]);
-  }
+  const std::vector<std::int64_t> place_nodes = mapper.placeNodes();
   {
     std::ofstream out = openOutput(out_dir / "source.txt");
     for (const std::string& uri : o.sources) out << absoluteSourceUri(uri) << "\n";
@@ -262,16 +201,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::ofstream out = openOutput(out_dir / "dropped_places.csv");
     writePlacesCsv(out, all.dropped_places);
   }
-  {
-    std::ofstream out = openOutput(out_dir / "timing.csv");
-    out << "frame,fingerprint_ms,segment_ms,filter_ms\n";
-    for (std::size_t i = 0; i < timing.size(); ++i) {
-      char line[112];
-      std::snprintf(line, sizeof(line), "%zu,%.4f,%.4f,%.4f\n", i, timing[i].fingerprint_ms,
-                    timing[i].segment_ms, timing[i].filter_ms);
-      out << line;
-    }
-  }
+  writeTimingCsv(out_dir / "timing.csv", timing);
   {
     std::ofstream out = openOutput(out_dir / "lambda2.svg");
     out << renderSvgLinePlot(lambda2Plot(
@@ -337,9 +267,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     }
     json.endArray();
     json.key("history").beginArray();
-    for (const StepRow& s : steps) {
+    for (const MappedPlace& s : mapper.steps()) {
       json.beginObject()
-          .field("place", s.place)
+          .field("place", s.place.index)
           .field("node", s.estimate.current_node)
           .field("probability", s.estimate.current_node_probability)
           .field("best_topology_probability", s.estimate.best.probability)
@@ -415,6 +345,7 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--resume", options->resume, "Continue the map in this map.tsm");
   cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
       ->capture_default_str();
+  addSegmentationOptions(*cmd, options->segmentation);
   cmd->callback([options, particles, alpha, seed, reps] {
     const bool filter_options_given = particles->count() + alpha->count() + seed->count() + reps->count() > 0;
     runMap(*options, filter_options_given);

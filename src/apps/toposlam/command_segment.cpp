@@ -14,6 +14,7 @@
 
 #include "bench_stats.hpp"
 #include "commands.hpp"
+#include "offline_run_io.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -21,9 +22,6 @@
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
-#ifdef TOPOSLAM_HAVE_SOURCES
-#include "toposlam/io/source_factory.hpp"
-#endif
 
 namespace toposlam::cli {
 
@@ -32,52 +30,18 @@ namespace {
 struct SegmentOptions {
   std::string source;
   std::string out;
-  int window = 25;
-  double gamma = 0.5;
-  double delta = 0.25;
-  int min_keypoints = 15;
+  SegmentationOptions segmentation;
   std::string keypoints = "orb";
-  std::string cut = "window-split";
   std::int64_t max_frames = 0;
   int workers = 1;
   bool quiet = false;
 };
 
-std::unique_ptr<FrameSource> openSource(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
-  return openFrameSource(uri);
-#else
-  throw FrameSourceError("cannot open '" + uri +
-                         "': this build has no frame sources (toposlam_sources was not "
-                         "built; see io/source_factory.hpp)");
-#endif
-}
-
-std::ofstream openOutput(const std::filesystem::path& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot create file (is the folder writable?)");
-  return out;
-}
-
 void runSegment(const SegmentOptions& o) {
-  FiedlerSegmenterConfig config;
-  config.window = o.window;
-  config.valley.gamma = o.gamma;
-  config.valley.delta = o.delta;
-  config.min_keypoints = o.min_keypoints;
-  config.cut_placement = parseCutPlacement(o.cut);
-  if (const std::string problem = config.validate(); !problem.empty()) {
-    throw std::invalid_argument("segment: " + problem);
-  }
+  const FiedlerSegmenterConfig config = segmenterConfig(o.segmentation, "segment");
   VpackConfig vpack;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
-
-  namespace fs = std::filesystem;
-  std::error_code error;
-  fs::create_directories(o.out, error);
-  if (error || !fs::is_directory(o.out)) {
-    throw std::runtime_error(o.out + ": cannot create the output folder (" + error.message() + ")");
-  }
+  createRunFolder(o.out);
 
   std::unique_ptr<FrameSource> source = openSource(o.source);
   std::unique_ptr<WorkerPool> pool;
@@ -89,6 +53,7 @@ void runSegment(const SegmentOptions& o) {
   const std::int64_t total = source->frameCountHint();
   if (!o.quiet) std::cerr << "segment: " << source->describe() << "\n";
   std::vector<double> fingerprint_ms, segment_ms;
+  std::vector<FrameTiming> timing;
   std::int64_t refused = 0;
   const auto started = std::chrono::steady_clock::now();
   auto last_report = started;
@@ -109,6 +74,7 @@ void runSegment(const SegmentOptions& o) {
     Stopwatch segment_watch;
     const SegmenterStep step = pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
     segment_ms.push_back(segment_watch.elapsedMs());
+    timing.push_back(FrameTiming{fingerprint_ms.back(), segment_ms.back(), std::nullopt});
     const auto now = std::chrono::steady_clock::now();
     if (!o.quiet && (step.closed_place || now - last_report > std::chrono::seconds(1))) {
       last_report = now;
@@ -128,7 +94,7 @@ void runSegment(const SegmentOptions& o) {
     throw std::runtime_error(o.source + ": the source gave no usable frames (" +
                              std::to_string(source->skippedFrames() + refused) + " skipped)");
   }
-  const fs::path dir(o.out);
+  const std::filesystem::path dir(o.out);
   {
     std::ofstream out = openOutput(dir / "source.txt");
     out << absoluteSourceUri(o.source) << "\n";
@@ -145,15 +111,7 @@ void runSegment(const SegmentOptions& o) {
     std::ofstream out = openOutput(dir / "dropped_places.csv");
     writePlacesCsv(out, run.dropped_places);
   }
-  {
-    std::ofstream out = openOutput(dir / "timing.csv");
-    out << "frame,fingerprint_ms,segment_ms,filter_ms\n";
-    for (std::size_t i = 0; i < segment_ms.size(); ++i) {
-      char line[96];
-      std::snprintf(line, sizeof(line), "%zu,%.4f,%.4f,\n", i, fingerprint_ms[i], segment_ms[i]);
-      out << line;
-    }
-  }
+  writeTimingCsv(dir / "timing.csv", timing);
   {
     std::ofstream out = openOutput(dir / "lambda2.svg");
     out << renderSvgLinePlot(lambda2Plot(run, config, "Fiedler value over " + o.source));
@@ -163,9 +121,9 @@ void runSegment(const SegmentOptions& o) {
   const TimingSummary s = summarize(segment_ms);
   std::printf(
       "%zu frames -> %zu places kept, %zu dropped (fewer than %d keypoints); window %d, gamma %.3g, "
-      "delta %.3g, %s\n",
+      "delta %.3g, similarity floor %.3g, %s\n",
       run.frames.size(), run.places.size(), run.dropped_places.size(), config.min_keypoints, config.window,
-      config.valley.gamma, config.valley.delta, toString(config.cut_placement));
+      config.valley.gamma, config.valley.delta, config.similarity_floor, toString(config.cut_placement));
   std::printf("ms per frame: fingerprint median %.2f p99 %.2f; segment median %.3f p99 %.3f\n", f.median_ms,
               f.p99_ms, s.median_ms, s.p99_ms);
   if (source->skippedFrames() + refused > 0) {
@@ -185,20 +143,8 @@ void addSegmentCommand(CLI::App& app) {
                   "Frame source URI: images:FOLDER_OR_GLOB, video:FILE, sim:WORLD?route=..., ...")
       ->required();
   cmd->add_option("--out", options->out, "Output run folder (created if missing)")->required();
-  cmd->add_option("--window", options->window, "Sliding window in frames")
-      ->capture_default_str()
-      ->check(CLI::Range(3, 1000));
-  cmd->add_option("--gamma", options->gamma, "Minimum lambda2 of a peak, [0, n/(n-1)]")
-      ->capture_default_str();
-  cmd->add_option("--delta", options->delta, "Minimum lambda2 swing between peak and valley, [0, gamma]")
-      ->capture_default_str();
-  cmd->add_option("--min-keypoints", options->min_keypoints,
-                  "Drop places whose representative has fewer keypoints")
-      ->capture_default_str();
+  addSegmentationOptions(*cmd, options->segmentation);
   cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
-      ->capture_default_str();
-  cmd->add_option("--cut", options->cut,
-                  "Where a place ends: window-split (best split of the valley's window) or valley-frame")
       ->capture_default_str();
   cmd->add_option("--max-frames", options->max_frames, "Stop after this many frames (0: whole stream)");
   cmd->add_option("--workers", options->workers, "Threads for the fingerprint's subregions")
