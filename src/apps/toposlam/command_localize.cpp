@@ -5,7 +5,8 @@
 //
 // Both CSV files hold `image,label` lines (paths relative to the CSV). Images sharing a label form one
 // place with several reference fingerprints. Bad lines and unreadable images are reported on stderr as
-// "file:line: problem" and skipped; the command fails only when no place or no query is usable.
+// "file:line: problem" and skipped; the command fails only when no place or no query is usable. A path
+// holding a comma is written in double quotes (RFC 4180), and --out quotes its fields the same way.
 #include <algorithm>
 #include <fstream>
 #include <iomanip>
