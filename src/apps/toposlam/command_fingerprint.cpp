@@ -88,7 +88,7 @@ void addFingerprintCommand(CLI::App& app) {
     for (const std::string& path : options->images) {
       try {
         const cv::Mat image = readImageFile(path);
-        Fingerprint f = extractor.extract(image);
+        const Fingerprint f = fingerprintImage(extractor, image, path);
         if (options->json)
           writeJson(json, path, f);
         else

@@ -71,13 +71,12 @@ class Progress {
 /// Fingerprints one CSV entry; nullopt (and a "file:line: ..." message on stderr) when it is unusable.
 std::optional<Fingerprint> fingerprintEntry(const VpackExtractor& extractor, const LabelledImage& entry,
                                             int& problems) {
-  std::string problem;
   try {
-    return extractor.extract(readImageFile(entry.path));
+    return fingerprintImageFile(extractor, entry.path);
   } catch (const std::exception& e) {
-    problem = e.what();  // "PATH: no such file", "PATH: not a readable image ...", or the extractor's
+    // "PATH: no such file", "PATH: not a readable image ...", or "PATH: " + the extractor's complaint.
+    std::cerr << entry.source << ": " << e.what() << "; skipped\n";
   }
-  std::cerr << entry.source << ": " << problem << "; skipped\n";
   ++problems;
   return std::nullopt;
 }

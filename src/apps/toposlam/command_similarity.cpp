@@ -24,15 +24,6 @@ struct SimilarityOptions {
   bool json = false;
 };
 
-Fingerprint fingerprintImage(const VpackExtractor& extractor, const std::string& path) {
-  const cv::Mat image = readImageFile(path);
-  try {
-    return extractor.extract(image);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-}
-
 // "2.450/5" style cell: effective count over the n-grams the reference could have had.
 std::string countCell(double count, int possible) {
   std::ostringstream cell;
@@ -100,8 +91,8 @@ void runSimilarity(const SimilarityOptions& o) {
   VpackConfig config;
   config.keypoints.backend = parseKeypointBackend(o.keypoints);
   const VpackExtractor extractor(config);
-  const Fingerprint a = fingerprintImage(extractor, o.first);
-  const Fingerprint b = fingerprintImage(extractor, o.second);
+  const Fingerprint a = fingerprintImageFile(extractor, o.first);
+  const Fingerprint b = fingerprintImageFile(extractor, o.second);
   const NgramSimilarity similarity;
   const SimilarityBreakdown ab = similarity.explain(a, b);
   const SimilarityBreakdown ba = similarity.explain(b, a);

@@ -22,6 +22,18 @@ cv::Mat readImageFile(const std::string& path) {
   return image;
 }
 
+Fingerprint fingerprintImage(const VpackExtractor& extractor, const cv::Mat& image, const std::string& path) {
+  try {
+    return extractor.extract(image);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+Fingerprint fingerprintImageFile(const VpackExtractor& extractor, const std::string& path) {
+  return fingerprintImage(extractor, readImageFile(path), path);
+}
+
 CLI::Option* addKeypointBackendOption(CLI::App& command, std::string& backend) {
   return command.add_option("--keypoints", backend, "Keypoint backend: orb, sift, brisk, akaze")
       ->check(CLI::IsMember({"orb", "sift", "brisk", "akaze"}, CLI::ignore_case))
