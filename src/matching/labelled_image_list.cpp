@@ -15,8 +15,11 @@ namespace {
 bool isSpace(unsigned char c) { return std::isspace(c) != 0; }
 
 std::string trim(const std::string& text) {
-  auto begin = std::find_if_not(text.begin(), text.end(), [](char c) { return isSpace(static_cast<unsigned char>(c)); });
-  auto end = std::find_if_not(text.rbegin(), text.rend(), [](char c) { return isSpace(static_cast<unsigned char>(c)); }).base();
+  auto begin = std::find_if_not(text.begin(), text.end(),
+                                [](char c) { return isSpace(static_cast<unsigned char>(c)); });
+  auto end = std::find_if_not(text.rbegin(), text.rend(), [](char c) {
+               return isSpace(static_cast<unsigned char>(c));
+             }).base();
   return begin < end ? std::string(begin, end) : std::string();
 }
 
@@ -78,7 +81,8 @@ std::optional<std::vector<std::string>> splitFields(const std::string& text, std
 
 LabelledImageList readLabelledImageList(const std::string& csv_path) {
   std::ifstream in(csv_path);
-  if (!in) throw std::runtime_error("cannot open '" + csv_path + "' (expected a CSV file of image,label lines)");
+  if (!in)
+    throw std::runtime_error("cannot open '" + csv_path + "' (expected a CSV file of image,label lines)");
   const std::filesystem::path folder = std::filesystem::path(csv_path).parent_path();
   LabelledImageList list;
   std::string line;
@@ -101,7 +105,8 @@ LabelledImageList readLabelledImageList(const std::string& csv_path) {
     }
     const std::vector<std::string>& fields = *parsed;
     if (fields.size() != 2) {
-      list.problems.push_back(where + ": expected 2 fields 'image,label', found " + std::to_string(fields.size()) +
+      list.problems.push_back(where + ": expected 2 fields 'image,label', found " +
+                              std::to_string(fields.size()) +
                               (fields.size() > 2 ? " (quote a path holding a comma: \"a,b.jpg\")" : ""));
       continue;
     }
@@ -117,10 +122,9 @@ LabelledImageList readLabelledImageList(const std::string& csv_path) {
 }
 
 std::string quoteCsvField(std::string_view field) {
-  const bool needs_quotes =
-      field.find_first_of(",\"\r\n") != std::string_view::npos ||
-      (!field.empty() && (isSpace(static_cast<unsigned char>(field.front())) ||
-                          isSpace(static_cast<unsigned char>(field.back()))));
+  const bool needs_quotes = field.find_first_of(",\"\r\n") != std::string_view::npos ||
+                            (!field.empty() && (isSpace(static_cast<unsigned char>(field.front())) ||
+                                                isSpace(static_cast<unsigned char>(field.back()))));
   if (!needs_quotes) return std::string(field);
   std::string out = "\"";
   for (char c : field) {

@@ -35,7 +35,8 @@ Fingerprint fingerprintFile(const std::string& path) {
 const std::vector<Fingerprint>& frames() {
   static const std::vector<Fingerprint> all = [] {
     std::vector<Fingerprint> f;
-    for (int i = 1; i <= 84; ++i) f.push_back(fingerprintFile(kData + "/samples/" + std::to_string(i) + ".jpg"));
+    for (int i = 1; i <= 84; ++i)
+      f.push_back(fingerprintFile(kData + "/samples/" + std::to_string(i) + ".jpg"));
     return f;
   }();
   return all;
@@ -87,7 +88,8 @@ Fingerprint reorderLetters(const Fingerprint& f, const std::vector<int>& order) 
     row = moved.keypoint_end;
     if (!out.subregions.empty()) out.edge_columns.push_back(moved.column_begin);
     out.subregions.push_back(moved);
-    for (int k = s.keypoint_begin; k < s.keypoint_end; ++k) out.keypoints.push_back(f.keypoints[static_cast<std::size_t>(k)]);
+    for (int k = s.keypoint_begin; k < s.keypoint_end; ++k)
+      out.keypoints.push_back(f.keypoints[static_cast<std::size_t>(k)]);
     if (s.keypointCount() > 0) blocks.push_back(f.descriptors.rowRange(s.keypoint_begin, s.keypoint_end));
   }
   out.descriptors = cv::Mat();
@@ -105,8 +107,9 @@ SCENARIO("GIVEN real frames WHEN a frame is compared with itself THEN it scores 
   }
 }
 
-SCENARIO("GIVEN the loop-closure ground truth WHEN pairs are compared THEN true revisits score higher than "
-         "distant places") {
+SCENARIO(
+    "GIVEN the loop-closure ground truth WHEN pairs are compared THEN true revisits score higher than "
+    "distant places") {
   const NgramSimilarity similarity;
   std::vector<double> revisits, distant;
   for (const auto& [query, matches] : groundTruth()) {
@@ -134,8 +137,9 @@ SCENARIO("GIVEN the loop-closure ground truth WHEN pairs are compared THEN true 
   CHECK(revisit_median > distant_median + 0.07);
 }
 
-SCENARIO("GIVEN a real frame WHEN its subregion order is shuffled THEN unigram counts stay and bigram and "
-         "trigram counts drop") {
+SCENARIO(
+    "GIVEN a real frame WHEN its subregion order is shuffled THEN unigram counts stay and bigram and "
+    "trigram counts drop") {
   const Fingerprint& f = frames()[63];  // frame 64, the one with the most letters (7)
   REQUIRE(f.subregions.size() == 7);
   std::vector<int> order(f.subregions.size());
@@ -147,11 +151,11 @@ SCENARIO("GIVEN a real frame WHEN its subregion order is shuffled THEN unigram c
   const NgramMatcher matcher;
   const NgramCounts same = matcher.counts(f, f);
   const NgramCounts mixed = matcher.counts(f, shuffled);
-  INFO("letters " << f.subregions.size() << "; histogram " << same.histogram[0] << "/" << same.histogram[1] << "/"
-                  << same.histogram[2] << " -> " << mixed.histogram[0] << "/" << mixed.histogram[1] << "/"
-                  << mixed.histogram[2] << "; keypoints " << same.keypoint[0] << "/" << same.keypoint[1] << "/"
-                  << same.keypoint[2] << " -> " << mixed.keypoint[0] << "/" << mixed.keypoint[1] << "/"
-                  << mixed.keypoint[2]);
+  INFO("letters " << f.subregions.size() << "; histogram " << same.histogram[0] << "/" << same.histogram[1]
+                  << "/" << same.histogram[2] << " -> " << mixed.histogram[0] << "/" << mixed.histogram[1]
+                  << "/" << mixed.histogram[2] << "; keypoints " << same.keypoint[0] << "/"
+                  << same.keypoint[1] << "/" << same.keypoint[2] << " -> " << mixed.keypoint[0] << "/"
+                  << mixed.keypoint[1] << "/" << mixed.keypoint[2]);
   // Measured: 7/6/5 n-grams with itself; the shuffle (seed 10) keeps two adjacent letter pairs, so
   // 7/2/0, for both feature types (every letter matches its own copy with score 1).
   CHECK(same.histogram == std::array<double, 3>{7.0, 6.0, 5.0});
@@ -164,8 +168,9 @@ SCENARIO("GIVEN a real frame WHEN its subregion order is shuffled THEN unigram c
   CHECK(mixed.keypoint[2] == 0.0);
 }
 
-SCENARIO("GIVEN the first traversal as places WHEN the second traversal is localised THEN precision is as "
-         "measured") {
+SCENARIO(
+    "GIVEN the first traversal as places WHEN the second traversal is localised THEN precision is as "
+    "measured") {
   const LabelledImageList place_list = readLabelledImageList(kData + "/places.csv");
   const LabelledImageList query_list = readLabelledImageList(kData + "/queries.csv");
   REQUIRE(place_list.problems.empty());

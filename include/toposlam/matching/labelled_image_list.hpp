@@ -14,9 +14,9 @@
 namespace toposlam {
 
 struct LabelledImage {
-  std::string path;   ///< resolved image path
+  std::string path;  ///< resolved image path
   std::string label;
-  std::string source; ///< "csv_file:line", for messages about this entry (missing image, ...)
+  std::string source;  ///< "csv_file:line", for messages about this entry (missing image, ...)
 };
 
 struct LabelledImageList {
