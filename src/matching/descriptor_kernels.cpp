@@ -33,41 +33,22 @@ template <typename Distance>
   }
 }
 
+// Best and second best reference row per query row. kWords > 0 fixes the row length at compile time
+// (the inner loop unrolls to kWords XOR + popcount); kWords == 0 takes it from `words` at run time.
 template <int kWords>
-[[gnu::always_inline]] inline void scanFixed(const std::uint64_t* query, int query_count,
-                                             const std::uint64_t* reference, int reference_count,
-                                             DescriptorMatch* out) {
+[[gnu::always_inline]] inline void scanBinary(const std::uint64_t* query, int query_count,
+                                              const std::uint64_t* reference, int reference_count,
+                                              int words, DescriptorMatch* out) {
+  const int row_words = kWords > 0 ? kWords : words;
   for (int q = 0; q < query_count; ++q) {
-    const std::uint64_t* qrow = query + static_cast<std::ptrdiff_t>(q) * kWords;
+    const std::uint64_t* qrow = query + static_cast<std::ptrdiff_t>(q) * row_words;
     int best = std::numeric_limits<int>::max();
     int second = std::numeric_limits<int>::max();
     int best_row = -1;
     for (int r = 0; r < reference_count; ++r) {
-      const std::uint64_t* rrow = reference + static_cast<std::ptrdiff_t>(r) * kWords;
+      const std::uint64_t* rrow = reference + static_cast<std::ptrdiff_t>(r) * row_words;
       int distance = 0;
-      for (int w = 0; w < kWords; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
-      consider(distance, r, best, second, best_row);
-    }
-    out[q].reference_keypoint = best_row;
-    out[q].distance = static_cast<float>(best);
-    out[q].second_distance = second == std::numeric_limits<int>::max()
-                                 ? std::numeric_limits<float>::infinity()
-                                 : static_cast<float>(second);
-  }
-}
-
-[[gnu::always_inline]] inline void scanAny(const std::uint64_t* query, int query_count,
-                                           const std::uint64_t* reference, int reference_count, int words,
-                                           DescriptorMatch* out) {
-  for (int q = 0; q < query_count; ++q) {
-    const std::uint64_t* qrow = query + static_cast<std::ptrdiff_t>(q) * words;
-    int best = std::numeric_limits<int>::max();
-    int second = std::numeric_limits<int>::max();
-    int best_row = -1;
-    for (int r = 0; r < reference_count; ++r) {
-      const std::uint64_t* rrow = reference + static_cast<std::ptrdiff_t>(r) * words;
-      int distance = 0;
-      for (int w = 0; w < words; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
+      for (int w = 0; w < row_words; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
       consider(distance, r, best, second, best_row);
     }
     out[q].reference_keypoint = best_row;
@@ -85,13 +66,13 @@ void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::u
                        int reference_count, int words, DescriptorMatch* out) {
   switch (words) {
     case 4:  // ORB, 32 bytes
-      scanFixed<4>(query, query_count, reference, reference_count, out);
+      scanBinary<4>(query, query_count, reference, reference_count, words, out);
       break;
     case 8:  // BRISK (64 bytes), AKAZE-MLDB (61 bytes, padded)
-      scanFixed<8>(query, query_count, reference, reference_count, out);
+      scanBinary<8>(query, query_count, reference, reference_count, words, out);
       break;
     default:
-      scanAny(query, query_count, reference, reference_count, words, out);
+      scanBinary<0>(query, query_count, reference, reference_count, words, out);
       break;
   }
 }

@@ -64,8 +64,7 @@ std::string MapStore::encode(const TopologyParticleFilter& filter, std::string_v
   return out;
 }
 
-LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& similarity,
-                           const std::string& name) {
+std::string_view MapStore::verifiedPayload(std::string_view file, const std::string& name) {
   if (file.size() < 8 || std::memcmp(file.data(), kMagic, 8) != 0) {
     throw MapStoreError(name + ": not a toposlam map file (bad magic)");
   }
@@ -89,6 +88,12 @@ LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& simil
   if (payload.size() > size)
     throw MapStoreError(name + ": damaged map file (trailing bytes after the payload)");
   if (fnv1a64(payload) != checksum) throw MapStoreError(name + ": damaged map file (checksum mismatch)");
+  return payload;
+}
+
+LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& similarity,
+                           const std::string& name) {
+  const std::string_view payload = verifiedPayload(file, name);
   try {
     topology_detail::BinaryReader reader(payload);
     const std::string_view state = reader.bytes("filter state");
@@ -102,6 +107,22 @@ LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& simil
     throw;
   } catch (const std::exception& e) {
     throw MapStoreError(name + ": damaged map file (" + e.what() + ")");
+  }
+}
+
+bool MapStore::fileVerifies(const std::filesystem::path& path) {
+  std::error_code ignored;
+  if (!std::filesystem::is_regular_file(path, ignored)) return false;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream content;
+  content << in.rdbuf();
+  if (in.bad()) return false;
+  try {
+    verifiedPayload(content.str(), path.string());
+    return true;
+  } catch (const MapStoreError&) {
+    return false;
   }
 }
 
@@ -146,9 +167,9 @@ void MapStore::writeAtomically(const std::filesystem::path& path, std::string_vi
     throw MapStoreError("cannot close map " + path.string() + ": " + errnoText(errno) +
                         " (the previous map file is unchanged)");
   }
-  // Keep the file being replaced as <path>.prev (best effort: a hard link, no copy).
-  std::error_code ignored;
-  if (std::filesystem::exists(path, ignored)) {
+  // Keep the file being replaced as <path>.prev (best effort: a hard link, no copy), but only when its
+  // framing verifies: a damaged file must not push the last good map out of <path>.prev.
+  if (fileVerifies(path)) {
     const std::string previous = path.string() + ".prev";
     const std::string previous_temp = temp.path + ".prev";
     if (::link(path.c_str(), previous_temp.c_str()) == 0) {

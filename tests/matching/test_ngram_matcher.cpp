@@ -153,9 +153,22 @@ SCENARIO("Similarity: self, symmetry and degenerate fingerprints") {
     const double kp = (2.1 / 5 + 1.55 / 4 + 0.7 / 3) / 3;
     CHECK(similarity.similarity(example.reference, example.query) == Approx(0.5 * hist + 0.5 * kp).epsilon(1e-6));
   }
-  THEN("the symmetric similarity is symmetric") {
+  THEN("the two directions differ for this asymmetric pair and the symmetric value is their mean") {
+    // Reversed roles: a keypoint letter scores matched / the new reference letter's keypoints, so
+    // Q0-R1 gives 2/3 (not 2/4), Q1-R2 2/2, Q2-R3 stays 3/5 (both letters have 5). Histograms
+    // are symmetric (Hellinger distance).
+    const double hist = (2.45 / 5 + 1.65 / 4 + (2.45 / 3) / 3) / 3;
+    const double kp_forward = (2.1 / 5 + 1.55 / 4 + 0.7 / 3) / 3;
+    const double kp_1 = 2.0 / 3 + 1.0 + 0.6;
+    const double kp_2 = (2.0 / 3 + 1.0) / 2 + (1.0 + 0.6) / 2;
+    const double kp_backward = (kp_1 / 5 + kp_2 / 4 + (kp_1 / 3) / 3) / 3;
+    const double forward = similarity.similarity(example.reference, example.query);
+    const double backward = similarity.similarity(example.query, example.reference);
+    CHECK(forward == Approx(0.5 * hist + 0.5 * kp_forward).epsilon(1e-6));
+    CHECK(backward == Approx(0.5 * hist + 0.5 * kp_backward).epsilon(1e-6));
+    CHECK(backward - forward > 0.01);
     CHECK(similarity.symmetricSimilarity(example.reference, example.query) ==
-          similarity.symmetricSimilarity(example.query, example.reference));
+          Approx(0.5 * (forward + backward)).epsilon(1e-12));
   }
   GIVEN("fingerprints without keypoints or without subregions") {
     Fingerprint no_keypoints = example.reference;
@@ -222,6 +235,28 @@ SCENARIO("Localisation guards the degenerate cases") {
     PlaceLocalizer localizer({}, {{"a", {example.reference}}, {"b", {example.query}}});
     const Localization l = localizer.localize(Fingerprint{});
     THEN("the result is uniform") { CHECK(l.probabilities[0] == Approx(0.5)); }
+  }
+  GIVEN("a query with subregions but no keypoints") {
+    Fingerprint no_keypoints = example.reference;
+    for (Subregion& s : no_keypoints.subregions) s.keypoint_begin = s.keypoint_end = 0;
+    no_keypoints.keypoints.clear();
+    no_keypoints.descriptors = cv::Mat();
+    REQUIRE(no_keypoints.validate().empty());
+    PlaceLocalizer localizer({}, {{"other", {example.query}}, {"self", {example.reference}}});
+    const Localization l = localizer.localize(no_keypoints);
+    THEN("the keypoint model is uniform and the histograms alone pick the right place") {
+      for (const PlaceModel& m : l.keypoint.ngrams) {
+        CHECK(m.probabilities[0] == Approx(0.5));
+        CHECK(std::isfinite(m.weight));
+      }
+      CHECK(l.keypoint.probabilities[0] == Approx(0.5));
+      CHECK(l.places[1].counts.query_keypoints == 0);
+      CHECK(l.places[1].counts.keypoint[0] == 0.0);
+      CHECK(l.best_place == 1);
+      CHECK(l.probabilities[0] + l.probabilities[1] == Approx(1.0));
+      CHECK(l.best_probability == Approx(l.histogram.probabilities[1]).epsilon(1e-9));
+      CHECK(l.best_probability > 0.6);
+    }
   }
   THEN("eq. 3.5-3.8 by hand, with a certain (zero-entropy) model not dividing by zero") {
     const InterpolatedModel m = PlaceLocalizer::interpolate({{{2.0, 0.0}, {1.0, 0.0}, {0.0, 0.0}}}, 0.01);

@@ -9,7 +9,9 @@
 // its place/frame bookkeeping there).
 //
 // Writing is atomic: a temporary file in the same directory is written, fsync'ed, renamed over the
-// target, and the directory is fsync'ed. The file it replaces is kept as "<path>.prev" (a hard link).
+// target, and the directory is fsync'ed. The file it replaces is kept as "<path>.prev" (a hard link),
+// but only when that file verifies (framing and checksum), so saving over a damaged map never pushes
+// the last good one out of .prev.
 // Any failure (e.g. a full disk) throws MapStoreError and leaves the old file untouched.
 // Loading refuses a wrong magic, a newer version, a truncated or damaged file with a MapStoreError that
 // says which; the file on disk is never modified by loading.
@@ -70,6 +72,14 @@ class MapStore {
                               const MapFileOps& ops = MapFileOps{});
   /// Throws MapStoreError (missing, unreadable, not a map, newer version, truncated, damaged).
   static LoadedMap load(const std::filesystem::path& path, const SimilarityMeasure& similarity);
+
+  /// True when `path` is a readable map file whose framing verifies (magic, version, size, checksum);
+  /// the payload is not parsed. writeAtomically keeps a replaced file as .prev only when this holds.
+  static bool fileVerifies(const std::filesystem::path& path);
+
+ private:
+  /// The payload of a file image whose framing verifies. Throws MapStoreError saying what is wrong.
+  static std::string_view verifiedPayload(std::string_view file, const std::string& name);
 };
 
 }  // namespace toposlam

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "commands.hpp"
+#include "sample_frames.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -24,14 +25,6 @@ struct FingerprintOptions {
   std::string draw;
   int workers = 1;
 };
-
-cv::Mat readImageOrThrow(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": no such file");
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw std::runtime_error(path + ": not a readable image (corrupt or unsupported format)");
-  if (image.depth() != CV_8U) image.convertTo(image, CV_8U, image.depth() == CV_16U ? 1.0 / 256.0 : 1.0);
-  return image;
-}
 
 std::string drawPath(const std::string& pattern, const std::string& image, std::size_t count) {
   if (count == 1) return pattern;
@@ -78,8 +71,7 @@ void addFingerprintCommand(CLI::App& app) {
   auto options = std::make_shared<FingerprintOptions>();
   auto* cmd = app.add_subcommand("fingerprint", "Print the VPACK fingerprint of images (thesis chapter 3.2)");
   cmd->add_option("images", options->images, "Image files")->required();
-  cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
-      ->check(CLI::IsMember({"orb", "sift", "brisk", "akaze"}, CLI::ignore_case));
+  addKeypointBackendOption(*cmd, options->keypoints);
   cmd->add_flag("--json", options->json, "Print JSON instead of text");
   cmd->add_option("--draw", options->draw,
                   "Write the frame with edges and keypoints drawn (OUT.png; OUT-<name>.png for several images)");
@@ -95,8 +87,8 @@ void addFingerprintCommand(CLI::App& app) {
     int failures = 0;
     for (const std::string& path : options->images) {
       try {
-        cv::Mat image = readImageOrThrow(path);
-        Fingerprint f = extractor.extract(image);
+        const cv::Mat image = readImageFile(path);
+        const Fingerprint f = fingerprintImage(extractor, image, path);
         if (options->json)
           writeJson(json, path, f);
         else

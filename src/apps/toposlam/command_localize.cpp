@@ -5,9 +5,9 @@
 //
 // Both CSV files hold `image,label` lines (paths relative to the CSV). Images sharing a label form one
 // place with several reference fingerprints. Bad lines and unreadable images are reported on stderr as
-// "file:line: problem" and skipped; the command fails only when no place or no query is usable.
+// "file:line: problem" and skipped; the command fails only when no place or no query is usable. A path
+// holding a comma is written in double quotes (RFC 4180), and --out quotes its fields the same way.
 #include <algorithm>
-#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -16,9 +16,8 @@
 #include <optional>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "commands.hpp"
+#include "sample_frames.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/labelled_image_list.hpp"
@@ -72,22 +71,12 @@ class Progress {
 /// Fingerprints one CSV entry; nullopt (and a "file:line: ..." message on stderr) when it is unusable.
 std::optional<Fingerprint> fingerprintEntry(const VpackExtractor& extractor, const LabelledImage& entry,
                                             int& problems) {
-  std::string problem;
-  if (!std::filesystem::exists(entry.path)) {
-    problem = "no such file";
-  } else {
-    const cv::Mat image = cv::imread(entry.path, cv::IMREAD_COLOR);
-    if (image.empty()) {
-      problem = "not a readable image (corrupt or unsupported format)";
-    } else {
-      try {
-        return extractor.extract(image);
-      } catch (const std::exception& e) {
-        problem = e.what();
-      }
-    }
+  try {
+    return fingerprintImageFile(extractor, entry.path);
+  } catch (const std::exception& e) {
+    // "PATH: no such file", "PATH: not a readable image ...", or "PATH: " + the extractor's complaint.
+    std::cerr << entry.source << ": " << e.what() << "; skipped\n";
   }
-  std::cerr << entry.source << ": image '" << entry.path << "': " << problem << "; skipped\n";
   ++problems;
   return std::nullopt;
 }
@@ -104,7 +93,7 @@ void writePredictions(const std::string& path, const std::vector<Prediction>& pr
   if (!out) throw std::runtime_error(path + ": cannot write the predictions file");
   out << "image,expected,label,probability,correct\n";
   for (const Prediction& p : predictions)
-    out << p.image << "," << p.expected << "," << p.predicted << "," << std::fixed << std::setprecision(6)
+    out << quoteCsvField(p.image) << "," << quoteCsvField(p.expected) << "," << quoteCsvField(p.predicted) << "," << std::fixed << std::setprecision(6)
         << p.probability << "," << (p.correct ? 1 : 0) << "\n";
   if (!out) throw std::runtime_error(path + ": write failed");
 }
@@ -228,9 +217,7 @@ void addLocalizeCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Write one prediction per query: image,expected,label,probability,correct");
-  cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
-      ->check(CLI::IsMember({"orb", "sift", "brisk", "akaze"}, CLI::ignore_case))
-      ->capture_default_str();
+  addKeypointBackendOption(*cmd, options->keypoints);
   cmd->add_flag("--normalise-counts", options->normalise_counts,
                 "Divide each place's n-gram counts by the n-grams its representative could have had");
   cmd->add_flag("--json", options->json, "Print JSON instead of the table");

@@ -1,16 +1,14 @@
 // `toposlam similarity A B`: the n-gram similarity of two images (thesis section 3.3.1), both ways and
 // symmetric, with the unigram/bigram/trigram counts behind it for histograms and keypoints, as text or
 // JSON. "A -> B" means A is the reference and B the query (NgramSimilarity::similarity(A, B)).
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "commands.hpp"
+#include "sample_frames.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
@@ -25,17 +23,6 @@ struct SimilarityOptions {
   std::string keypoints = "orb";
   bool json = false;
 };
-
-Fingerprint fingerprintImage(const VpackExtractor& extractor, const std::string& path) {
-  if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": no such file");
-  cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
-  if (image.empty()) throw std::runtime_error(path + ": not a readable image (corrupt or unsupported format)");
-  try {
-    return extractor.extract(image);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-}
 
 // "2.450/5" style cell: effective count over the n-grams the reference could have had.
 std::string countCell(double count, int possible) {
@@ -104,8 +91,8 @@ void runSimilarity(const SimilarityOptions& o) {
   VpackConfig config;
   config.keypoints.backend = parseKeypointBackend(o.keypoints);
   const VpackExtractor extractor(config);
-  const Fingerprint a = fingerprintImage(extractor, o.first);
-  const Fingerprint b = fingerprintImage(extractor, o.second);
+  const Fingerprint a = fingerprintImageFile(extractor, o.first);
+  const Fingerprint b = fingerprintImageFile(extractor, o.second);
   const NgramSimilarity similarity;
   const SimilarityBreakdown ab = similarity.explain(a, b);
   const SimilarityBreakdown ba = similarity.explain(b, a);
@@ -135,9 +122,7 @@ void addSimilarityCommand(CLI::App& app) {
                                  "n-gram similarity of two images, both ways and symmetric (thesis 3.3.1)");
   cmd->add_option("a", options->first, "First image")->required();
   cmd->add_option("b", options->second, "Second image")->required();
-  cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
-      ->check(CLI::IsMember({"orb", "sift", "brisk", "akaze"}, CLI::ignore_case))
-      ->capture_default_str();
+  addKeypointBackendOption(*cmd, options->keypoints);
   cmd->add_flag("--json", options->json, "Print JSON instead of text");
   cmd->callback([options] { runSimilarity(*options); });
 }

@@ -1,4 +1,4 @@
-// Sample frames for benchmarks: see the header.
+// Image input for the CLI commands and sample frames for benchmarks: see the header.
 #include "sample_frames.hpp"
 
 #include <cstdlib>
@@ -11,6 +11,34 @@
 #include "toposlam/core/natural_order.hpp"
 
 namespace toposlam::cli {
+
+cv::Mat readImageFile(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw std::runtime_error(path + ": no such file");
+  if (std::filesystem::is_directory(path, error)) throw std::runtime_error(path + ": is a folder, not an image");
+  // ANYCOLOR without ANYDEPTH: 8-bit, grey kept as one channel, colour as BGR (alpha dropped).
+  cv::Mat image = cv::imread(path, cv::IMREAD_ANYCOLOR);
+  if (image.empty()) throw std::runtime_error(path + ": not a readable image (corrupt or unsupported format)");
+  return image;
+}
+
+Fingerprint fingerprintImage(const VpackExtractor& extractor, const cv::Mat& image, const std::string& path) {
+  try {
+    return extractor.extract(image);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+Fingerprint fingerprintImageFile(const VpackExtractor& extractor, const std::string& path) {
+  return fingerprintImage(extractor, readImageFile(path), path);
+}
+
+CLI::Option* addKeypointBackendOption(CLI::App& command, std::string& backend) {
+  return command.add_option("--keypoints", backend, "Keypoint backend: orb, sift, brisk, akaze")
+      ->check(CLI::IsMember({"orb", "sift", "brisk", "akaze"}, CLI::ignore_case))
+      ->capture_default_str();
+}
 
 std::string defaultSamplesFolder() {
   if (const char* env = std::getenv("TOPOSLAM_SAMPLES")) return env;
