@@ -13,6 +13,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <tuple>
 
 #include <libcamera/camera.h>
 #include <libcamera/camera_manager.h>
@@ -32,17 +33,6 @@
 namespace toposlam {
 
 namespace {
-
-int parseInt(const std::string& key, const std::string& text, const std::string& example) {
-  try {
-    std::size_t used = 0;
-    const int value = std::stoi(text, &used);
-    if (used == text.size()) return value;
-  } catch (const std::exception&) {
-  }
-  throw FrameSourceError("libcamera: " + key + ": expected an integer like " + example + ", got '" + text +
-                         "'");
-}
 
 /// libcamera allows one CameraManager per process: share it while any user holds it.
 std::shared_ptr<libcamera::CameraManager> sharedCameraManager() {
@@ -85,41 +75,20 @@ std::string LibcameraSourceConfig::validate() const {
   return "";
 }
 
-LibcameraSourceConfig parseLibcameraUri(const std::string& uri) {
-  const std::string scheme = "libcamera:";
-  if (uri.rfind(scheme, 0) != 0)
-    throw FrameSourceError("libcamera: URI must start with 'libcamera:', got '" + uri + "'");
-  const std::string rest = uri.substr(scheme.size());
-  const auto question = rest.find('?');
+LibcameraSourceConfig parseLibcameraUri(const SourceUri& uri) {
+  if (uri.scheme != "libcamera")
+    throw FrameSourceError("libcamera: URI must start with 'libcamera:', got '" + uri.text + "'");
+  uri.requireOnly({"size", "buffers"});
   LibcameraSourceConfig config;
-  config.camera_id = rest.substr(0, question);
-  if (question != std::string::npos) {
-    std::stringstream query(rest.substr(question + 1));
-    std::string item;
-    while (std::getline(query, item, '&')) {
-      if (item.empty()) continue;
-      const auto equals = item.find('=');
-      const std::string key = item.substr(0, equals);
-      const std::string value = equals == std::string::npos ? "" : item.substr(equals + 1);
-      if (key == "size") {
-        const auto x = value.find('x');
-        if (x == std::string::npos)
-          throw FrameSourceError("libcamera: size: expected WxH like 640x480, got '" + value + "'");
-        config.width = parseInt("size", value.substr(0, x), "640x480");
-        config.height = parseInt("size", value.substr(x + 1), "640x480");
-      } else if (key == "buffers") {
-        config.buffer_count = parseInt("buffers", value, "4");
-      } else if (key == "rate") {
-        // The factory's common real-time key (openFrameSource wraps the source); a camera is real time.
-      } else {
-        throw FrameSourceError("libcamera: unknown parameter '" + key + "' (allowed: size, buffers)");
-      }
-    }
-  }
+  config.camera_id = uri.path;
+  std::tie(config.width, config.height) = uri.getSize("size", {config.width, config.height}, 16, 8192);
+  config.buffer_count = static_cast<int>(uri.getInt("buffers", config.buffer_count, 2, 16));
   if (const std::string problem = config.validate(); !problem.empty())
-    throw FrameSourceError("libcamera: " + problem);
+    throw FrameSourceError("source '" + uri.text + "': " + problem);
   return config;
 }
+
+LibcameraSourceConfig parseLibcameraUri(const std::string& uri) { return parseLibcameraUri(parseSourceUri(uri)); }
 
 std::vector<std::string> listLibcameraCameras() {
   auto manager = sharedCameraManager();

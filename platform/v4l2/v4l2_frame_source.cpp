@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include <spdlog/spdlog.h>
@@ -54,16 +55,6 @@ int bytesPerPixel(std::uint32_t fourcc) {
 bool canConvert(std::uint32_t fourcc) { return isCompressed(fourcc) || bytesPerPixel(fourcc) > 0; }
 
 const char* kConvertibleFormats = "yuyv, mjpeg, grey, bgr24, rgb24";
-
-int parseInt(const std::string& key, const std::string& text, const std::string& example) {
-  try {
-    std::size_t used = 0;
-    const int value = std::stoi(text, &used);
-    if (used == text.size()) return value;
-  } catch (const std::exception&) {
-  }
-  throw FrameSourceError("v4l2: " + key + ": expected an integer like " + example + ", got '" + text + "'");
-}
 
 }  // namespace
 
@@ -133,70 +124,33 @@ std::string V4l2SourceConfig::validate() const {
   return "";
 }
 
-V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults) {
-  const std::string scheme = "v4l2:";
-  if (uri.rfind(scheme, 0) != 0)
-    throw FrameSourceError("v4l2: URI must start with 'v4l2:', got '" + uri + "'");
-  const std::string rest = uri.substr(scheme.size());
-  const auto question = rest.find('?');
+V4l2SourceConfig parseV4l2Uri(const SourceUri& uri, const V4l2SourceConfig& defaults) {
+  if (uri.scheme != "v4l2") throw FrameSourceError("v4l2: URI must start with 'v4l2:', got '" + uri.text + "'");
+  if (uri.path.empty() || uri.path.front() != '/' || uri.path.find('?') != std::string::npos)
+    throw FrameSourceError("v4l2: expected a device path like v4l2:/dev/video0?size=640x480 (query items are "
+                           "key=value), got '" + uri.text + "'");
+  uri.requireOnly({"size", "fps", "format", "buffers", "wait"});
   V4l2SourceConfig config = defaults;
-  config.device = rest.substr(0, question);
-  if (config.device.empty() || config.device.front() != '/')
-    throw FrameSourceError("v4l2: expected a device path like v4l2:/dev/video0, got '" + uri + "'");
-  if (question != std::string::npos) {
-    std::stringstream query(rest.substr(question + 1));
-    std::string item;
-    while (std::getline(query, item, '&')) {
-      if (item.empty()) continue;
-      const auto equals = item.find('=');
-      const std::string key = item.substr(0, equals);
-      const std::string value = equals == std::string::npos ? "" : item.substr(equals + 1);
-      if (key == "size") {
-        const auto x = value.find('x');
-        if (x == std::string::npos)
-          throw FrameSourceError("v4l2: size: expected WxH like 640x480, got '" + value + "'");
-        config.width = parseInt("size", value.substr(0, x), "640x480");
-        config.height = parseInt("size", value.substr(x + 1), "640x480");
-      } else if (key == "fps") {
-        try {
-          std::size_t used = 0;
-          config.fps = std::stod(value, &used);
-          if (used != value.size()) throw std::invalid_argument("trailing text");
-        } catch (const std::exception&) {
-          throw FrameSourceError("v4l2: fps: expected a number like 30, got '" + value + "'");
-        }
-      } else if (key == "format") {
-        if (value == "yuyv")
-          config.format = V4l2PixelFormat::Yuyv;
-        else if (value == "mjpeg")
-          config.format = V4l2PixelFormat::Mjpeg;
-        else if (value == "grey" || value == "gray")
-          config.format = V4l2PixelFormat::Grey;
-        else if (value == "bgr24")
-          config.format = V4l2PixelFormat::Bgr24;
-        else if (value == "rgb24")
-          config.format = V4l2PixelFormat::Rgb24;
-        else
-          throw FrameSourceError("v4l2: format: expected one of " + std::string(kConvertibleFormats) +
-                                 ", got '" + value + "'");
-      } else if (key == "buffers") {
-        config.buffer_count = parseInt("buffers", value, "4");
-      } else if (key == "wait") {
-        if (value != "0" && value != "1")
-          throw FrameSourceError("v4l2: wait: expected 0 (fail if the camera is missing at start) or 1 "
-                                 "(wait for it), got '" + value + "'");
-        config.wait_at_start = value == "1";
-      } else if (key == "rate") {
-        // The factory's common real-time key (openFrameSource wraps the source); a camera is real time.
-      } else {
-        throw FrameSourceError("v4l2: unknown parameter '" + key +
-                               "' (allowed: size, fps, format, buffers, wait)");
-      }
-    }
-  }
+  config.device = uri.path;
+  std::tie(config.width, config.height) = uri.getSize("size", {config.width, config.height}, 16, 8192);
+  config.fps = uri.getDouble("fps", config.fps, 0.0, 1000.0);  // 0 itself is refused by validate()
+  static const std::vector<std::pair<std::string, V4l2PixelFormat>> kFormats = {
+      {"yuyv", V4l2PixelFormat::Yuyv},   {"mjpeg", V4l2PixelFormat::Mjpeg}, {"grey", V4l2PixelFormat::Grey},
+      {"gray", V4l2PixelFormat::Grey},   {"bgr24", V4l2PixelFormat::Bgr24}, {"rgb24", V4l2PixelFormat::Rgb24}};
+  std::vector<std::string> format_names;
+  for (const auto& [name, format] : kFormats) format_names.push_back(name);
+  const std::string format_name = uri.getChoice("format", toString(config.format), format_names);
+  for (const auto& [name, format] : kFormats)
+    if (name == format_name) config.format = format;
+  config.buffer_count = static_cast<int>(uri.getInt("buffers", config.buffer_count, 2, 32));
+  config.wait_at_start = uri.getBool("wait", config.wait_at_start);
   if (const std::string problem = config.validate(); !problem.empty())
-    throw FrameSourceError("v4l2: " + problem);
+    throw FrameSourceError("source '" + uri.text + "': " + problem);
   return config;
+}
+
+V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults) {
+  return parseV4l2Uri(parseSourceUri(uri), defaults);
 }
 
 // ---------------------------------------------------------------------------------------------
