@@ -12,6 +12,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -24,8 +25,9 @@
 #include <libcamera/request.h>
 #include <libcamera/stream.h>
 #include <libcamera/version.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core/mat.hpp>
+
+#include "camera_pixels.hpp"
 
 #define TOPOSLAM_LIBCAMERA_VERSION \
   (LIBCAMERA_VERSION_MAJOR * 10000 + LIBCAMERA_VERSION_MINOR * 100 + LIBCAMERA_VERSION_PATCH)
@@ -53,11 +55,22 @@ std::string cameraList(const libcamera::CameraManager& manager) {
   return list.empty() ? std::string("libcamera found no cameras on this machine") : "available: " + list;
 }
 
+/// The layout (camera_pixels.hpp) of a format toposlam converts; nullopt for anything else. RGB888 is
+/// B,G,R in memory (OpenCV's BGR), BGR888 is R,G,B.
+std::optional<CameraPixelLayout> layoutOf(const libcamera::PixelFormat& format) {
+  if (format == libcamera::formats::RGB888) return CameraPixelLayout::Bgr;
+  if (format == libcamera::formats::BGR888) return CameraPixelLayout::Rgb;
+  if (format == libcamera::formats::YUYV) return CameraPixelLayout::Yuyv;
+  if (format == libcamera::formats::MJPEG) return CameraPixelLayout::Jpeg;
+  return std::nullopt;
+}
+
 /// One mmap of a dmabuf-backed buffer (plane 0 and everything before its end).
 struct Mapping {
   void* base = nullptr;
   std::size_t length = 0;
   std::uint8_t* pixels = nullptr;  // plane 0
+  std::size_t pixel_bytes = 0;     // plane 0's length
 };
 
 }  // namespace
@@ -113,6 +126,7 @@ struct LibcameraFrameSource::Impl : std::enable_shared_from_this<Impl> {
   std::unique_ptr<libcamera::FrameBufferAllocator> allocator;
   libcamera::Stream* stream = nullptr;
   libcamera::PixelFormat pixel_format;
+  CameraPixelLayout layout = CameraPixelLayout::Bgr;  ///< of pixel_format
   int width = 0;
   int height = 0;
   unsigned int stride = 0;
@@ -216,14 +230,14 @@ LibcameraFrameSource::LibcameraFrameSource(LibcameraSourceConfig config) : impl_
     throw FrameSourceError(where + ": the camera refused every configuration close to " +
                            std::to_string(config.width) + "x" + std::to_string(config.height));
   const libcamera::PixelFormat chosen = stream_config.pixelFormat;
-  if (chosen != libcamera::formats::RGB888 && chosen != libcamera::formats::BGR888 &&
-      chosen != libcamera::formats::YUYV && chosen != libcamera::formats::MJPEG)
+  if (!layoutOf(chosen))
     throw FrameSourceError(where + ": the camera only offers " + chosen.toString() +
                            ", which toposlam cannot convert (RGB888, BGR888, YUYV, MJPEG)");
   if (impl.camera->configure(impl.configuration.get()) < 0)
     throw FrameSourceError(where + ": configuring " + stream_config.toString() + " failed");
   impl.stream = stream_config.stream();
   impl.pixel_format = stream_config.pixelFormat;
+  impl.layout = *layoutOf(impl.pixel_format);
   impl.width = static_cast<int>(stream_config.size.width);
   impl.height = static_cast<int>(stream_config.size.height);
   impl.stride = stream_config.stride;
@@ -238,7 +252,7 @@ LibcameraFrameSource::LibcameraFrameSource(LibcameraSourceConfig config) : impl_
     const std::size_t length = static_cast<std::size_t>(plane.offset) + plane.length;
     void* base = mmap(nullptr, length, PROT_READ, MAP_SHARED, plane.fd.get(), 0);
     if (base == MAP_FAILED) throw FrameSourceError(where + ": cannot map a frame buffer");
-    impl.mappings[buffer.get()] = Mapping{base, length, static_cast<std::uint8_t*>(base) + plane.offset};
+    impl.mappings[buffer.get()] = Mapping{base, length, static_cast<std::uint8_t*>(base) + plane.offset, plane.length};
     std::unique_ptr<libcamera::Request> request = impl.camera->createRequest();
     if (!request || request->addBuffer(impl.stream, buffer.get()) < 0)
       throw FrameSourceError(where + ": cannot create a capture request");
@@ -334,27 +348,16 @@ SourceWait LibcameraFrameSource::nextFor(std::chrono::milliseconds timeout, Fram
     Frame frame;
     frame.timestamp_s = static_cast<double>(metadata.timestamp) * 1e-9;  // ns, CLOCK_BOOTTIME/MONOTONIC
     frame.sequence = static_cast<std::int64_t>(metadata.sequence);
-    if (impl.pixel_format == libcamera::formats::RGB888) {
+    if (impl.layout == CameraPixelLayout::Bgr) {
       frame.image = cv::Mat(impl.height, impl.width, CV_8UC3, mapping.pixels, impl.stride);
       std::shared_ptr<Impl> owner = impl_;
       frame.buffer_lease =
           std::shared_ptr<void>(mapping.pixels, [owner, request](void*) { owner->requeue(request); });
     } else {
-      if (impl.pixel_format == libcamera::formats::BGR888) {
-        cv::cvtColor(cv::Mat(impl.height, impl.width, CV_8UC3, mapping.pixels, impl.stride), frame.image,
-                     cv::COLOR_RGB2BGR);
-      } else if (impl.pixel_format == libcamera::formats::YUYV) {
-        cv::cvtColor(cv::Mat(impl.height, impl.width, CV_8UC2, mapping.pixels, impl.stride), frame.image,
-                     cv::COLOR_YUV2BGR_YUYV);
-      } else {
-        try {
-          frame.image = cv::imdecode(
-              cv::Mat(1, static_cast<int>(std::min(used, mapping.length)), CV_8UC1, mapping.pixels),
-              cv::IMREAD_COLOR);
-        } catch (const cv::Exception&) {
-          frame.image.release();
-        }
-      }
+      // Packed layouts: the whole mapped plane; JPEG: the bytes the camera wrote.
+      const std::size_t bytes =
+          impl.layout == CameraPixelLayout::Jpeg ? std::min(used, mapping.pixel_bytes) : mapping.pixel_bytes;
+      frame.image = cameraBufferToBgr(impl.layout, mapping.pixels, bytes, impl.width, impl.height, impl.stride);
       impl.requeue(request);
       if (frame.image.empty()) {
         std::lock_guard lock(impl.mutex);

@@ -11,13 +11,15 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <tuple>
 #include <utility>
 
 #include <spdlog/spdlog.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core/mat.hpp>
+
+#include "camera_pixels.hpp"
 
 namespace toposlam {
 
@@ -33,26 +35,24 @@ std::string textOf(const std::uint8_t* bytes, std::size_t capacity) {
   return std::string(bytes, bytes + length);
 }
 
-bool isCompressed(std::uint32_t fourcc) {
-  return fourcc == V4L2_PIX_FMT_MJPEG || fourcc == V4L2_PIX_FMT_JPEG;
-}
-
-/// Bytes per pixel of the uncompressed formats we convert; 0 for anything else.
-int bytesPerPixel(std::uint32_t fourcc) {
+/// The layout of a fourcc toposlam converts (camera_pixels.hpp); nullopt for anything else.
+std::optional<CameraPixelLayout> layoutOf(std::uint32_t fourcc) {
   switch (fourcc) {
     case V4L2_PIX_FMT_YUYV:
-      return 2;
+      return CameraPixelLayout::Yuyv;
     case V4L2_PIX_FMT_GREY:
-      return 1;
-    case V4L2_PIX_FMT_BGR24:
+      return CameraPixelLayout::Grey;
     case V4L2_PIX_FMT_RGB24:
-      return 3;
+      return CameraPixelLayout::Rgb;
+    case V4L2_PIX_FMT_BGR24:
+      return CameraPixelLayout::Bgr;
+    case V4L2_PIX_FMT_MJPEG:
+    case V4L2_PIX_FMT_JPEG:
+      return CameraPixelLayout::Jpeg;
     default:
-      return 0;
+      return std::nullopt;
   }
 }
-
-bool canConvert(std::uint32_t fourcc) { return isCompressed(fourcc) || bytesPerPixel(fourcc) > 0; }
 
 const char* kConvertibleFormats = "yuyv, mjpeg, grey, bgr24, rgb24";
 
@@ -348,7 +348,8 @@ bool V4l2FrameSource::start(bool absent_is_ok) {
          (r == -EBUSY ? "; another program is streaming from it" : ""));
   // Use what the driver chose.
   const std::uint32_t fourcc = format.fmt.pix.pixelformat;
-  if (!canConvert(fourcc))
+  const std::optional<CameraPixelLayout> layout = layoutOf(fourcc);
+  if (!layout)
     fail("driver '" + driver + "' chose pixel format " + fourccName(fourcc) + " instead of " +
          fourccName(wanted) + ", which toposlam cannot convert (it converts " + kConvertibleFormats + ")");
   const int width = static_cast<int>(format.fmt.pix.width);
@@ -357,8 +358,8 @@ bool V4l2FrameSource::start(bool absent_is_ok) {
   if (fourcc == V4L2_PIX_FMT_YUYV && width % 2 != 0)
     fail("driver returned an odd YUYV width " + std::to_string(width));
   std::uint32_t bytes_per_line = format.fmt.pix.bytesperline;
-  const auto min_line = static_cast<std::uint32_t>(width * bytesPerPixel(fourcc));
-  if (!isCompressed(fourcc) && bytes_per_line < min_line) bytes_per_line = min_line;
+  const auto min_line = static_cast<std::uint32_t>(width * bytesPerPixel(*layout));
+  if (*layout != CameraPixelLayout::Jpeg && bytes_per_line < min_line) bytes_per_line = min_line;
   if (fourcc != wanted)
     spdlog::warn("{}: driver chose {} instead of {}; converting from it", where, fourccName(fourcc),
                  fourccName(wanted));
@@ -624,57 +625,35 @@ std::optional<Frame> V4l2FrameSource::handleBuffer(const ::v4l2_buffer& buffer) 
     frame.timestamp_s = runtime_.monotonic_s();
   }
 
-  if (isCompressed(fourcc_)) {
+  const CameraPixelLayout layout = layoutOf(fourcc_).value_or(CameraPixelLayout::Jpeg);  // checked at start
+  if (layout == CameraPixelLayout::Jpeg) {
     if (used == 0) return skip(&V4l2SourceStatus::short_buffers, "empty buffer");
-    cv::Mat decoded;
-    try {
-      const cv::Mat encoded(1, static_cast<int>(used), CV_8UC1, const_cast<std::uint8_t*>(data));
-      decoded = cv::imdecode(encoded, cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      decoded.release();
-    }
-    if (decoded.empty()) return skip(&V4l2SourceStatus::decode_failures, "MJPEG did not decode");
+    frame.image = cameraBufferToBgr(layout, data, used, width_, height_, bytes_per_line_);
+    if (frame.image.empty()) return skip(&V4l2SourceStatus::decode_failures, "MJPEG did not decode");
     requeue(buffer.index);
-    frame.image = std::move(decoded);
   } else {
     const std::size_t expected =
         static_cast<std::size_t>(bytes_per_line_) * static_cast<std::size_t>(height_);
     if (used < expected || mapped->length < expected)
       return skip(&V4l2SourceStatus::short_buffers, "short buffer");
-    void* pixels = mapped->address;
-    switch (fourcc_) {
-      case V4L2_PIX_FMT_YUYV:
-        cv::cvtColor(cv::Mat(height_, width_, CV_8UC2, pixels, bytes_per_line_), frame.image,
-                     cv::COLOR_YUV2BGR_YUYV);
-        requeue(buffer.index);
-        break;
-      case V4L2_PIX_FMT_GREY:
-        cv::cvtColor(cv::Mat(height_, width_, CV_8UC1, pixels, bytes_per_line_), frame.image,
-                     cv::COLOR_GRAY2BGR);
-        requeue(buffer.index);
-        break;
-      case V4L2_PIX_FMT_RGB24:
-        cv::cvtColor(cv::Mat(height_, width_, CV_8UC3, pixels, bytes_per_line_), frame.image,
-                     cv::COLOR_RGB2BGR);
-        requeue(buffer.index);
-        break;
-      case V4L2_PIX_FMT_BGR24: {
-        // Zero copy: the image views the driver's buffer; the lease gives it back.
-        frame.image = cv::Mat(height_, width_, CV_8UC3, pixels, bytes_per_line_);
-        std::shared_ptr<Stream> stream = stream_;
-        std::shared_ptr<MappedBuffer> keep = mapped;
-        const std::uint32_t index = buffer.index;
-        frame.buffer_lease = std::shared_ptr<void>(pixels, [stream, keep, index](void*) {
-          {
-            std::lock_guard lock(stream->mutex);
-            if (stream->active) stream->queueLocked(index);
-          }
-          stream->buffer_returned.notify_all();
-        });
-        break;
-      }
-      default:
-        return skip(&V4l2SourceStatus::decode_failures, "unexpected pixel format");
+    if (layout == CameraPixelLayout::Bgr) {
+      // Zero copy: the image views the driver's buffer; the lease gives it back.
+      void* pixels = mapped->address;
+      frame.image = cv::Mat(height_, width_, CV_8UC3, pixels, bytes_per_line_);
+      std::shared_ptr<Stream> stream = stream_;
+      std::shared_ptr<MappedBuffer> keep = mapped;
+      const std::uint32_t index = buffer.index;
+      frame.buffer_lease = std::shared_ptr<void>(pixels, [stream, keep, index](void*) {
+        {
+          std::lock_guard lock(stream->mutex);
+          if (stream->active) stream->queueLocked(index);
+        }
+        stream->buffer_returned.notify_all();
+      });
+    } else {
+      frame.image = cameraBufferToBgr(layout, data, used, width_, height_, bytes_per_line_);
+      if (frame.image.empty()) return skip(&V4l2SourceStatus::decode_failures, "conversion failed");
+      requeue(buffer.index);
     }
   }
   updateStatus([](V4l2SourceStatus& s) { ++s.frames; });
