@@ -167,6 +167,7 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.frames_captured = s.frames_captured;
   msg.frames_published = s.frames_published;
   msg.frames_dropped = s.frames_dropped;
+  msg.queue_kept_waits = s.queue_kept_waits;
   msg.source_skipped = s.source_skipped;
   msg.source_state = toString(s.source_link);
   msg.source_reconnects = s.source_reconnects;
@@ -327,7 +328,8 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);
       w.field("frames_captured", m.frames_captured).field("frames_published", m.frames_published)
-          .field("frames_dropped", m.frames_dropped).field("source_state", m.source_state)
+          .field("frames_dropped", m.frames_dropped).field("queue_kept_waits", m.queue_kept_waits)
+          .field("source_state", m.source_state)
           .field("source_reconnects", m.source_reconnects).field("source_reconnect_attempts", m.source_reconnect_attempts)
           .field("source_dropped", m.source_dropped);
       jsonNumber(w, "latency_median_ms", m.latency_median_ms);
@@ -348,11 +350,12 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       w.endArray();
       char line[320];
       std::snprintf(line, sizeof line,
-                    "STATUS %s  %.1f fps  latency median %.1f / p99 %.1f ms  %lld published  %lld dropped  cpu %.0f%%  "
-                    "camera %s (%lld reconnects, %lld lost by the driver)",
+                    "STATUS %s  %.1f fps  latency median %.1f / p99 %.1f ms  %lld published  %lld dropped  "
+                    "%lld kept waits  cpu %.0f%%  camera %s (%lld reconnects, %lld lost by the driver)",
                     m.state.c_str(), static_cast<double>(m.fps), static_cast<double>(m.latency_median_ms),
                     static_cast<double>(m.latency_p99_ms), static_cast<long long>(m.frames_published),
-                    static_cast<long long>(m.frames_dropped), static_cast<double>(m.cpu_percent),
+                    static_cast<long long>(m.frames_dropped), static_cast<long long>(m.queue_kept_waits),
+                    static_cast<double>(m.cpu_percent),
                     m.source_state.c_str(), static_cast<long long>(m.source_reconnects),
                     static_cast<long long>(m.source_dropped));
       out.summary = line;

@@ -12,7 +12,9 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
+#include <tuple>
 
 #include <libcamera/camera.h>
 #include <libcamera/camera_manager.h>
@@ -23,8 +25,9 @@
 #include <libcamera/request.h>
 #include <libcamera/stream.h>
 #include <libcamera/version.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core/mat.hpp>
+
+#include "camera_pixels.hpp"
 
 #define TOPOSLAM_LIBCAMERA_VERSION \
   (LIBCAMERA_VERSION_MAJOR * 10000 + LIBCAMERA_VERSION_MINOR * 100 + LIBCAMERA_VERSION_PATCH)
@@ -32,17 +35,6 @@
 namespace toposlam {
 
 namespace {
-
-int parseInt(const std::string& key, const std::string& text, const std::string& example) {
-  try {
-    std::size_t used = 0;
-    const int value = std::stoi(text, &used);
-    if (used == text.size()) return value;
-  } catch (const std::exception&) {
-  }
-  throw FrameSourceError("libcamera: " + key + ": expected an integer like " + example + ", got '" + text +
-                         "'");
-}
 
 /// libcamera allows one CameraManager per process: share it while any user holds it.
 std::shared_ptr<libcamera::CameraManager> sharedCameraManager() {
@@ -63,11 +55,22 @@ std::string cameraList(const libcamera::CameraManager& manager) {
   return list.empty() ? std::string("libcamera found no cameras on this machine") : "available: " + list;
 }
 
+/// The layout (camera_pixels.hpp) of a format toposlam converts; nullopt for anything else. RGB888 is
+/// B,G,R in memory (OpenCV's BGR), BGR888 is R,G,B.
+std::optional<CameraPixelLayout> layoutOf(const libcamera::PixelFormat& format) {
+  if (format == libcamera::formats::RGB888) return CameraPixelLayout::Bgr;
+  if (format == libcamera::formats::BGR888) return CameraPixelLayout::Rgb;
+  if (format == libcamera::formats::YUYV) return CameraPixelLayout::Yuyv;
+  if (format == libcamera::formats::MJPEG) return CameraPixelLayout::Jpeg;
+  return std::nullopt;
+}
+
 /// One mmap of a dmabuf-backed buffer (plane 0 and everything before its end).
 struct Mapping {
   void* base = nullptr;
   std::size_t length = 0;
   std::uint8_t* pixels = nullptr;  // plane 0
+  std::size_t pixel_bytes = 0;     // plane 0's length
 };
 
 }  // namespace
@@ -85,41 +88,20 @@ std::string LibcameraSourceConfig::validate() const {
   return "";
 }
 
-LibcameraSourceConfig parseLibcameraUri(const std::string& uri) {
-  const std::string scheme = "libcamera:";
-  if (uri.rfind(scheme, 0) != 0)
-    throw FrameSourceError("libcamera: URI must start with 'libcamera:', got '" + uri + "'");
-  const std::string rest = uri.substr(scheme.size());
-  const auto question = rest.find('?');
+LibcameraSourceConfig parseLibcameraUri(const SourceUri& uri) {
+  if (uri.scheme != "libcamera")
+    throw FrameSourceError("libcamera: URI must start with 'libcamera:', got '" + uri.text + "'");
+  uri.requireOnly({"size", "buffers"});
   LibcameraSourceConfig config;
-  config.camera_id = rest.substr(0, question);
-  if (question != std::string::npos) {
-    std::stringstream query(rest.substr(question + 1));
-    std::string item;
-    while (std::getline(query, item, '&')) {
-      if (item.empty()) continue;
-      const auto equals = item.find('=');
-      const std::string key = item.substr(0, equals);
-      const std::string value = equals == std::string::npos ? "" : item.substr(equals + 1);
-      if (key == "size") {
-        const auto x = value.find('x');
-        if (x == std::string::npos)
-          throw FrameSourceError("libcamera: size: expected WxH like 640x480, got '" + value + "'");
-        config.width = parseInt("size", value.substr(0, x), "640x480");
-        config.height = parseInt("size", value.substr(x + 1), "640x480");
-      } else if (key == "buffers") {
-        config.buffer_count = parseInt("buffers", value, "4");
-      } else if (key == "rate") {
-        // The factory's common real-time key (openFrameSource wraps the source); a camera is real time.
-      } else {
-        throw FrameSourceError("libcamera: unknown parameter '" + key + "' (allowed: size, buffers)");
-      }
-    }
-  }
+  config.camera_id = uri.path;
+  std::tie(config.width, config.height) = uri.getSize("size", {config.width, config.height}, 16, 8192);
+  config.buffer_count = static_cast<int>(uri.getInt("buffers", config.buffer_count, 2, 16));
   if (const std::string problem = config.validate(); !problem.empty())
-    throw FrameSourceError("libcamera: " + problem);
+    throw FrameSourceError("source '" + uri.text + "': " + problem);
   return config;
 }
+
+LibcameraSourceConfig parseLibcameraUri(const std::string& uri) { return parseLibcameraUri(parseSourceUri(uri)); }
 
 std::vector<std::string> listLibcameraCameras() {
   auto manager = sharedCameraManager();
@@ -144,6 +126,7 @@ struct LibcameraFrameSource::Impl : std::enable_shared_from_this<Impl> {
   std::unique_ptr<libcamera::FrameBufferAllocator> allocator;
   libcamera::Stream* stream = nullptr;
   libcamera::PixelFormat pixel_format;
+  CameraPixelLayout layout = CameraPixelLayout::Bgr;  ///< of pixel_format
   int width = 0;
   int height = 0;
   unsigned int stride = 0;
@@ -247,14 +230,14 @@ LibcameraFrameSource::LibcameraFrameSource(LibcameraSourceConfig config) : impl_
     throw FrameSourceError(where + ": the camera refused every configuration close to " +
                            std::to_string(config.width) + "x" + std::to_string(config.height));
   const libcamera::PixelFormat chosen = stream_config.pixelFormat;
-  if (chosen != libcamera::formats::RGB888 && chosen != libcamera::formats::BGR888 &&
-      chosen != libcamera::formats::YUYV && chosen != libcamera::formats::MJPEG)
+  if (!layoutOf(chosen))
     throw FrameSourceError(where + ": the camera only offers " + chosen.toString() +
                            ", which toposlam cannot convert (RGB888, BGR888, YUYV, MJPEG)");
   if (impl.camera->configure(impl.configuration.get()) < 0)
     throw FrameSourceError(where + ": configuring " + stream_config.toString() + " failed");
   impl.stream = stream_config.stream();
   impl.pixel_format = stream_config.pixelFormat;
+  impl.layout = *layoutOf(impl.pixel_format);
   impl.width = static_cast<int>(stream_config.size.width);
   impl.height = static_cast<int>(stream_config.size.height);
   impl.stride = stream_config.stride;
@@ -269,7 +252,7 @@ LibcameraFrameSource::LibcameraFrameSource(LibcameraSourceConfig config) : impl_
     const std::size_t length = static_cast<std::size_t>(plane.offset) + plane.length;
     void* base = mmap(nullptr, length, PROT_READ, MAP_SHARED, plane.fd.get(), 0);
     if (base == MAP_FAILED) throw FrameSourceError(where + ": cannot map a frame buffer");
-    impl.mappings[buffer.get()] = Mapping{base, length, static_cast<std::uint8_t*>(base) + plane.offset};
+    impl.mappings[buffer.get()] = Mapping{base, length, static_cast<std::uint8_t*>(base) + plane.offset, plane.length};
     std::unique_ptr<libcamera::Request> request = impl.camera->createRequest();
     if (!request || request->addBuffer(impl.stream, buffer.get()) < 0)
       throw FrameSourceError(where + ": cannot create a capture request");
@@ -365,27 +348,16 @@ SourceWait LibcameraFrameSource::nextFor(std::chrono::milliseconds timeout, Fram
     Frame frame;
     frame.timestamp_s = static_cast<double>(metadata.timestamp) * 1e-9;  // ns, CLOCK_BOOTTIME/MONOTONIC
     frame.sequence = static_cast<std::int64_t>(metadata.sequence);
-    if (impl.pixel_format == libcamera::formats::RGB888) {
+    if (impl.layout == CameraPixelLayout::Bgr) {
       frame.image = cv::Mat(impl.height, impl.width, CV_8UC3, mapping.pixels, impl.stride);
       std::shared_ptr<Impl> owner = impl_;
       frame.buffer_lease =
           std::shared_ptr<void>(mapping.pixels, [owner, request](void*) { owner->requeue(request); });
     } else {
-      if (impl.pixel_format == libcamera::formats::BGR888) {
-        cv::cvtColor(cv::Mat(impl.height, impl.width, CV_8UC3, mapping.pixels, impl.stride), frame.image,
-                     cv::COLOR_RGB2BGR);
-      } else if (impl.pixel_format == libcamera::formats::YUYV) {
-        cv::cvtColor(cv::Mat(impl.height, impl.width, CV_8UC2, mapping.pixels, impl.stride), frame.image,
-                     cv::COLOR_YUV2BGR_YUYV);
-      } else {
-        try {
-          frame.image = cv::imdecode(
-              cv::Mat(1, static_cast<int>(std::min(used, mapping.length)), CV_8UC1, mapping.pixels),
-              cv::IMREAD_COLOR);
-        } catch (const cv::Exception&) {
-          frame.image.release();
-        }
-      }
+      // Packed layouts: the whole mapped plane; JPEG: the bytes the camera wrote.
+      const std::size_t bytes =
+          impl.layout == CameraPixelLayout::Jpeg ? std::min(used, mapping.pixel_bytes) : mapping.pixel_bytes;
+      frame.image = cameraBufferToBgr(impl.layout, mapping.pixels, bytes, impl.width, impl.height, impl.stride);
       impl.requeue(request);
       if (frame.image.empty()) {
         std::lock_guard lock(impl.mutex);

@@ -8,7 +8,7 @@ void registerLibcameraFrameSourceScheme() {
   registerFrameSourceScheme(
       "libcamera",
       [](const SourceUri& uri) -> std::unique_ptr<FrameSource> {
-        return std::make_unique<LibcameraFrameSource>(parseLibcameraUri(uri.text));
+        return std::make_unique<LibcameraFrameSource>(parseLibcameraUri(uri));
       },
       "libcamera:ID?size=WxH&buffers=N (empty ID: the first camera)");
 }

@@ -11,12 +11,15 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include <spdlog/spdlog.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core/mat.hpp>
+
+#include "camera_pixels.hpp"
 
 namespace toposlam {
 
@@ -32,38 +35,26 @@ std::string textOf(const std::uint8_t* bytes, std::size_t capacity) {
   return std::string(bytes, bytes + length);
 }
 
-bool isCompressed(std::uint32_t fourcc) {
-  return fourcc == V4L2_PIX_FMT_MJPEG || fourcc == V4L2_PIX_FMT_JPEG;
-}
-
-/// Bytes per pixel of the uncompressed formats we convert; 0 for anything else.
-int bytesPerPixel(std::uint32_t fourcc) {
+/// The layout of a fourcc toposlam converts (camera_pixels.hpp); nullopt for anything else.
+std::optional<CameraPixelLayout> layoutOf(std::uint32_t fourcc) {
   switch (fourcc) {
     case V4L2_PIX_FMT_YUYV:
-      return 2;
+      return CameraPixelLayout::Yuyv;
     case V4L2_PIX_FMT_GREY:
-      return 1;
-    case V4L2_PIX_FMT_BGR24:
+      return CameraPixelLayout::Grey;
     case V4L2_PIX_FMT_RGB24:
-      return 3;
+      return CameraPixelLayout::Rgb;
+    case V4L2_PIX_FMT_BGR24:
+      return CameraPixelLayout::Bgr;
+    case V4L2_PIX_FMT_MJPEG:
+    case V4L2_PIX_FMT_JPEG:
+      return CameraPixelLayout::Jpeg;
     default:
-      return 0;
+      return std::nullopt;
   }
 }
-
-bool canConvert(std::uint32_t fourcc) { return isCompressed(fourcc) || bytesPerPixel(fourcc) > 0; }
 
 const char* kConvertibleFormats = "yuyv, mjpeg, grey, bgr24, rgb24";
-
-int parseInt(const std::string& key, const std::string& text, const std::string& example) {
-  try {
-    std::size_t used = 0;
-    const int value = std::stoi(text, &used);
-    if (used == text.size()) return value;
-  } catch (const std::exception&) {
-  }
-  throw FrameSourceError("v4l2: " + key + ": expected an integer like " + example + ", got '" + text + "'");
-}
 
 }  // namespace
 
@@ -133,70 +124,33 @@ std::string V4l2SourceConfig::validate() const {
   return "";
 }
 
-V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults) {
-  const std::string scheme = "v4l2:";
-  if (uri.rfind(scheme, 0) != 0)
-    throw FrameSourceError("v4l2: URI must start with 'v4l2:', got '" + uri + "'");
-  const std::string rest = uri.substr(scheme.size());
-  const auto question = rest.find('?');
+V4l2SourceConfig parseV4l2Uri(const SourceUri& uri, const V4l2SourceConfig& defaults) {
+  if (uri.scheme != "v4l2") throw FrameSourceError("v4l2: URI must start with 'v4l2:', got '" + uri.text + "'");
+  if (uri.path.empty() || uri.path.front() != '/' || uri.path.find('?') != std::string::npos)
+    throw FrameSourceError("v4l2: expected a device path like v4l2:/dev/video0?size=640x480 (query items are "
+                           "key=value), got '" + uri.text + "'");
+  uri.requireOnly({"size", "fps", "format", "buffers", "wait"});
   V4l2SourceConfig config = defaults;
-  config.device = rest.substr(0, question);
-  if (config.device.empty() || config.device.front() != '/')
-    throw FrameSourceError("v4l2: expected a device path like v4l2:/dev/video0, got '" + uri + "'");
-  if (question != std::string::npos) {
-    std::stringstream query(rest.substr(question + 1));
-    std::string item;
-    while (std::getline(query, item, '&')) {
-      if (item.empty()) continue;
-      const auto equals = item.find('=');
-      const std::string key = item.substr(0, equals);
-      const std::string value = equals == std::string::npos ? "" : item.substr(equals + 1);
-      if (key == "size") {
-        const auto x = value.find('x');
-        if (x == std::string::npos)
-          throw FrameSourceError("v4l2: size: expected WxH like 640x480, got '" + value + "'");
-        config.width = parseInt("size", value.substr(0, x), "640x480");
-        config.height = parseInt("size", value.substr(x + 1), "640x480");
-      } else if (key == "fps") {
-        try {
-          std::size_t used = 0;
-          config.fps = std::stod(value, &used);
-          if (used != value.size()) throw std::invalid_argument("trailing text");
-        } catch (const std::exception&) {
-          throw FrameSourceError("v4l2: fps: expected a number like 30, got '" + value + "'");
-        }
-      } else if (key == "format") {
-        if (value == "yuyv")
-          config.format = V4l2PixelFormat::Yuyv;
-        else if (value == "mjpeg")
-          config.format = V4l2PixelFormat::Mjpeg;
-        else if (value == "grey" || value == "gray")
-          config.format = V4l2PixelFormat::Grey;
-        else if (value == "bgr24")
-          config.format = V4l2PixelFormat::Bgr24;
-        else if (value == "rgb24")
-          config.format = V4l2PixelFormat::Rgb24;
-        else
-          throw FrameSourceError("v4l2: format: expected one of " + std::string(kConvertibleFormats) +
-                                 ", got '" + value + "'");
-      } else if (key == "buffers") {
-        config.buffer_count = parseInt("buffers", value, "4");
-      } else if (key == "wait") {
-        if (value != "0" && value != "1")
-          throw FrameSourceError("v4l2: wait: expected 0 (fail if the camera is missing at start) or 1 "
-                                 "(wait for it), got '" + value + "'");
-        config.wait_at_start = value == "1";
-      } else if (key == "rate") {
-        // The factory's common real-time key (openFrameSource wraps the source); a camera is real time.
-      } else {
-        throw FrameSourceError("v4l2: unknown parameter '" + key +
-                               "' (allowed: size, fps, format, buffers, wait)");
-      }
-    }
-  }
+  config.device = uri.path;
+  std::tie(config.width, config.height) = uri.getSize("size", {config.width, config.height}, 16, 8192);
+  config.fps = uri.getDouble("fps", config.fps, 0.0, 1000.0);  // 0 itself is refused by validate()
+  static const std::vector<std::pair<std::string, V4l2PixelFormat>> kFormats = {
+      {"yuyv", V4l2PixelFormat::Yuyv},   {"mjpeg", V4l2PixelFormat::Mjpeg}, {"grey", V4l2PixelFormat::Grey},
+      {"gray", V4l2PixelFormat::Grey},   {"bgr24", V4l2PixelFormat::Bgr24}, {"rgb24", V4l2PixelFormat::Rgb24}};
+  std::vector<std::string> format_names;
+  for (const auto& [name, format] : kFormats) format_names.push_back(name);
+  const std::string format_name = uri.getChoice("format", toString(config.format), format_names);
+  for (const auto& [name, format] : kFormats)
+    if (name == format_name) config.format = format;
+  config.buffer_count = static_cast<int>(uri.getInt("buffers", config.buffer_count, 2, 32));
+  config.wait_at_start = uri.getBool("wait", config.wait_at_start);
   if (const std::string problem = config.validate(); !problem.empty())
-    throw FrameSourceError("v4l2: " + problem);
+    throw FrameSourceError("source '" + uri.text + "': " + problem);
   return config;
+}
+
+V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults) {
+  return parseV4l2Uri(parseSourceUri(uri), defaults);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -394,7 +348,8 @@ bool V4l2FrameSource::start(bool absent_is_ok) {
          (r == -EBUSY ? "; another program is streaming from it" : ""));
   // Use what the driver chose.
   const std::uint32_t fourcc = format.fmt.pix.pixelformat;
-  if (!canConvert(fourcc))
+  const std::optional<CameraPixelLayout> layout = layoutOf(fourcc);
+  if (!layout)
     fail("driver '" + driver + "' chose pixel format " + fourccName(fourcc) + " instead of " +
          fourccName(wanted) + ", which toposlam cannot convert (it converts " + kConvertibleFormats + ")");
   const int width = static_cast<int>(format.fmt.pix.width);
@@ -403,8 +358,8 @@ bool V4l2FrameSource::start(bool absent_is_ok) {
   if (fourcc == V4L2_PIX_FMT_YUYV && width % 2 != 0)
     fail("driver returned an odd YUYV width " + std::to_string(width));
   std::uint32_t bytes_per_line = format.fmt.pix.bytesperline;
-  const auto min_line = static_cast<std::uint32_t>(width * bytesPerPixel(fourcc));
-  if (!isCompressed(fourcc) && bytes_per_line < min_line) bytes_per_line = min_line;
+  const auto min_line = static_cast<std::uint32_t>(width * bytesPerPixel(*layout));
+  if (*layout != CameraPixelLayout::Jpeg && bytes_per_line < min_line) bytes_per_line = min_line;
   if (fourcc != wanted)
     spdlog::warn("{}: driver chose {} instead of {}; converting from it", where, fourccName(fourcc),
                  fourccName(wanted));
@@ -670,57 +625,35 @@ std::optional<Frame> V4l2FrameSource::handleBuffer(const ::v4l2_buffer& buffer) 
     frame.timestamp_s = runtime_.monotonic_s();
   }
 
-  if (isCompressed(fourcc_)) {
+  const CameraPixelLayout layout = layoutOf(fourcc_).value_or(CameraPixelLayout::Jpeg);  // checked at start
+  if (layout == CameraPixelLayout::Jpeg) {
     if (used == 0) return skip(&V4l2SourceStatus::short_buffers, "empty buffer");
-    cv::Mat decoded;
-    try {
-      const cv::Mat encoded(1, static_cast<int>(used), CV_8UC1, const_cast<std::uint8_t*>(data));
-      decoded = cv::imdecode(encoded, cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      decoded.release();
-    }
-    if (decoded.empty()) return skip(&V4l2SourceStatus::decode_failures, "MJPEG did not decode");
+    frame.image = cameraBufferToBgr(layout, data, used, width_, height_, bytes_per_line_);
+    if (frame.image.empty()) return skip(&V4l2SourceStatus::decode_failures, "MJPEG did not decode");
     requeue(buffer.index);
-    frame.image = std::move(decoded);
   } else {
     const std::size_t expected =
         static_cast<std::size_t>(bytes_per_line_) * static_cast<std::size_t>(height_);
     if (used < expected || mapped->length < expected)
       return skip(&V4l2SourceStatus::short_buffers, "short buffer");
-    void* pixels = mapped->address;
-    switch (fourcc_) {
-      case V4L2_PIX_FMT_YUYV:
-        cv::cvtColor(cv::Mat(height_, width_, CV_8UC2, pixels, bytes_per_line_), frame.image,
-                     cv::COLOR_YUV2BGR_YUYV);
-        requeue(buffer.index);
-        break;
-      case V4L2_PIX_FMT_GREY:
-        cv::cvtColor(cv::Mat(height_, width_, CV_8UC1, pixels, bytes_per_line_), frame.image,
-                     cv::COLOR_GRAY2BGR);
-        requeue(buffer.index);
-        break;
-      case V4L2_PIX_FMT_RGB24:
-        cv::cvtColor(cv::Mat(height_, width_, CV_8UC3, pixels, bytes_per_line_), frame.image,
-                     cv::COLOR_RGB2BGR);
-        requeue(buffer.index);
-        break;
-      case V4L2_PIX_FMT_BGR24: {
-        // Zero copy: the image views the driver's buffer; the lease gives it back.
-        frame.image = cv::Mat(height_, width_, CV_8UC3, pixels, bytes_per_line_);
-        std::shared_ptr<Stream> stream = stream_;
-        std::shared_ptr<MappedBuffer> keep = mapped;
-        const std::uint32_t index = buffer.index;
-        frame.buffer_lease = std::shared_ptr<void>(pixels, [stream, keep, index](void*) {
-          {
-            std::lock_guard lock(stream->mutex);
-            if (stream->active) stream->queueLocked(index);
-          }
-          stream->buffer_returned.notify_all();
-        });
-        break;
-      }
-      default:
-        return skip(&V4l2SourceStatus::decode_failures, "unexpected pixel format");
+    if (layout == CameraPixelLayout::Bgr) {
+      // Zero copy: the image views the driver's buffer; the lease gives it back.
+      void* pixels = mapped->address;
+      frame.image = cv::Mat(height_, width_, CV_8UC3, pixels, bytes_per_line_);
+      std::shared_ptr<Stream> stream = stream_;
+      std::shared_ptr<MappedBuffer> keep = mapped;
+      const std::uint32_t index = buffer.index;
+      frame.buffer_lease = std::shared_ptr<void>(pixels, [stream, keep, index](void*) {
+        {
+          std::lock_guard lock(stream->mutex);
+          if (stream->active) stream->queueLocked(index);
+        }
+        stream->buffer_returned.notify_all();
+      });
+    } else {
+      frame.image = cameraBufferToBgr(layout, data, used, width_, height_, bytes_per_line_);
+      if (frame.image.empty()) return skip(&V4l2SourceStatus::decode_failures, "conversion failed");
+      requeue(buffer.index);
     }
   }
   updateStatus([](V4l2SourceStatus& s) { ++s.frames; });

@@ -10,7 +10,7 @@ void registerV4l2FrameSourceScheme(bool wait_at_start) {
       [wait_at_start](const SourceUri& uri) -> std::unique_ptr<FrameSource> {
         V4l2SourceConfig defaults;
         defaults.wait_at_start = wait_at_start;
-        return std::make_unique<V4l2FrameSource>(parseV4l2Uri(uri.text, defaults));
+        return std::make_unique<V4l2FrameSource>(parseV4l2Uri(uri, defaults));
       },
       "v4l2:/dev/videoN?size=WxH&fps=F&format=yuyv|mjpeg|grey|bgr24|rgb24&buffers=N&wait=0|1");
 }

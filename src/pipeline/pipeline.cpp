@@ -77,9 +77,10 @@ std::string statusLine(const PipelineStatus& s) {
     std::snprintf(camera, sizeof camera, "camera streaming (%lld reconnects, %lld lost by the driver)",
                   static_cast<long long>(s.source_reconnects), static_cast<long long>(s.source_dropped));
   char text[384];
-  std::snprintf(text, sizeof text, "%s: %.1f fps, latency p99 %.1f ms, %d places, map rev %lld, %lld dropped; %s",
+  std::snprintf(text, sizeof text,
+                "%s: %.1f fps, latency p99 %.1f ms, %d places, map rev %lld, %lld dropped, %lld kept waits; %s",
                 s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
-                static_cast<long long>(s.frames_dropped), camera);
+                static_cast<long long>(s.frames_dropped), static_cast<long long>(s.queue_kept_waits), camera);
   return text;
 }
 
@@ -467,12 +468,14 @@ void Pipeline::publisherLoop() {
       st.latency = summarizeLatencies(window[i]);
       st.processed = i == kPublisher ? published : processed_[i].load();
       st.dropped = inputs[i].dropped;
+      st.kept_waits = inputs[i].kept_waits;
       st.queue_depth = inputs[i].depth;
       st.queue_capacity = inputs[i].capacity;
       const double cpu = thread_cpu_s_[i].load();
       st.cpu_percent = 100.0 * (cpu - stage_cpu_start[i]) / elapsed;
       stage_cpu_start[i] = cpu;
       s.frames_dropped += inputs[i].dropped;
+      s.queue_kept_waits += inputs[i].kept_waits;
       s.stages.push_back(std::move(st));
     }
     const double process_cpu = processCpuSeconds();

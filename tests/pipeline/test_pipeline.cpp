@@ -378,6 +378,12 @@ SCENARIO("GIVEN a publisher that falls far behind WHEN drop-oldest queues overfl
     CHECK(s.frames_dropped >= 59 - 16 - 16 - 2);
     CHECK(s.frames_dropped == s.stages[kPublisherStage].dropped + s.stages[kTopologyStage].dropped);
     CHECK(estimates == 120 - s.frames_dropped);
+    // A producer that finds its queue full of place records waits instead of dropping (kept_waits).
+    // Only the two drop-oldest queues whose records may carry places can fill (the others hold 1024);
+    // each push waits at most once, and only pushes of place records wait: at most 40 per queue.
+    CHECK(s.queue_kept_waits == s.stages[kPublisherStage].kept_waits + s.stages[kTopologyStage].kept_waits);
+    CHECK(s.queue_kept_waits <= 2 * 40);
+    CHECK_THAT(statusLine(s), Catch::Contains(std::to_string(s.queue_kept_waits) + " kept waits"));
   }
 }
 
@@ -426,8 +432,10 @@ SCENARIO("The status line names the camera state") {
   s.fps = 29.84;
   s.places = 4;
   s.map_revision = 4;
-  CHECK(statusLine(s) == "running: 29.8 fps, latency p99 0.0 ms, 4 places, map rev 4, 0 dropped; camera streaming (0 "
-                         "reconnects, 0 lost by the driver)");
+  s.frames_dropped = 12;
+  s.queue_kept_waits = 3;
+  CHECK(statusLine(s) == "running: 29.8 fps, latency p99 0.0 ms, 4 places, map rev 4, 12 dropped, 3 kept waits; camera "
+                         "streaming (0 reconnects, 0 lost by the driver)");
   s.source_link = SourceLink::Reconnecting;
   s.source_reconnect_attempts = 0;
   s.source_reconnects = 1;

@@ -62,11 +62,16 @@ SCENARIO("GIVEN libcamera URIs WHEN parsed THEN the ID and parameters are read a
   CHECK(config.height == 240);
   CHECK(config.buffer_count == 6);
   CHECK(toposlam::parseLibcameraUri("libcamera:").camera_id.empty());
+  CHECK(toposlam::parseLibcameraUri("libcamera:?size=1280x720&rate=1").width == 1280);  // rate: factory's key
   CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?size=big"),
-                    Catch::Contains("size: expected WxH"));
+                    Catch::Contains("size=big") && Catch::Contains("expected WxH with each side in 16..8192"));
+  CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?size=320x9000"),
+                    Catch::Contains("size=320x9000") && Catch::Contains("16..8192"));
   CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?buffers=64"),
-                    Catch::Contains("buffers: must be in [2, 16]"));
+                    Catch::Contains("buffers=64 is out of range; expected a whole number in 2..16"));
+  CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?buffers=many"),
+                    Catch::Contains("buffers=many is not a whole number"));
   CHECK_THROWS_WITH(toposlam::parseLibcameraUri("libcamera:x?fps=30"),
-                    Catch::Contains("unknown parameter 'fps'"));
+                    Catch::Contains("unknown query key 'fps' for libcamera:; allowed: size, buffers, rate"));
   CHECK_THROWS_AS(toposlam::parseLibcameraUri("v4l2:/dev/video0"), FrameSourceError);
 }

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "toposlam/io/frame_source.hpp"
+#include "toposlam/io/source_uri.hpp"
 
 namespace toposlam {
 
@@ -36,7 +37,9 @@ struct LibcameraSourceConfig {
   std::string validate() const;
 };
 
-/// Parses "libcamera:ID?size=WxH&buffers=N". Throws FrameSourceError naming the bad key.
+/// Parses "libcamera:ID?size=WxH&buffers=N" (`rate` is the factory's common key). Throws
+/// FrameSourceError naming the key, the bad value and the allowed range, or listing the allowed keys.
+LibcameraSourceConfig parseLibcameraUri(const SourceUri& uri);
 LibcameraSourceConfig parseLibcameraUri(const std::string& uri);
 
 /// Registers the `libcamera:` scheme with openFrameSource() (io/source_factory.hpp). Call once at start-up.

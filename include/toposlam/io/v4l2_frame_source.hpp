@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "toposlam/io/frame_source.hpp"
+#include "toposlam/io/source_uri.hpp"
 #include "toposlam/io/v4l2_device.hpp"
 
 struct v4l2_buffer;  // <linux/videodev2.h>
@@ -74,8 +75,10 @@ struct V4l2SourceConfig {
 };
 
 /// Parses "v4l2:/dev/videoN?size=WxH&fps=F&format=yuyv|mjpeg|grey|bgr24|rgb24&buffers=N&wait=0|1"
-/// (all parameters optional; `defaults` fills the rest). Throws FrameSourceError with the offending key
-/// on bad input.
+/// (all parameters optional; `defaults` fills the rest; `gray` = `grey`; `wait` takes any SourceUri
+/// switch: 1|0|true|false|yes|no|on|off; `rate` is the factory's common key). Throws FrameSourceError
+/// naming the key, the bad value and the allowed range (SourceUri getters), or listing the allowed keys.
+V4l2SourceConfig parseV4l2Uri(const SourceUri& uri, const V4l2SourceConfig& defaults = {});
 V4l2SourceConfig parseV4l2Uri(const std::string& uri, const V4l2SourceConfig& defaults = {});
 
 /// Registers the `v4l2:` scheme with openFrameSource() (io/source_factory.hpp). Call once at start-up.

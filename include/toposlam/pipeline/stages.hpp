@@ -149,6 +149,7 @@ struct StageStatus {
   LatencyStats latency;         ///< this stage's own processing time per frame, last status period
   std::int64_t processed = 0;   ///< frames this stage finished since start
   std::int64_t dropped = 0;     ///< frames dropped from this stage's INPUT queue since start
+  std::int64_t kept_waits = 0;  ///< producer waits on the INPUT queue: full of place records (never dropped)
   std::size_t queue_depth = 0;  ///< items waiting in its input queue now
   std::size_t queue_capacity = 0;
   double cpu_percent = 0.0;     ///< CPU time of the stage's thread over the last period (100 = one core)
@@ -161,6 +162,7 @@ struct PipelineStatus {
   std::int64_t frames_captured = 0;
   std::int64_t frames_published = 0;
   std::int64_t frames_dropped = 0;   ///< all queues together (only per-frame estimates; places are kept)
+  std::int64_t queue_kept_waits = 0; ///< all queues together: a producer waited, the queue held only places
   std::int64_t source_skipped = 0;   ///< bad frames the source skipped
   SourceLink source_link = SourceLink::Streaming;  ///< the camera: streaming or reconnecting
   std::int64_t source_reconnects = 0;              ///< camera outages survived

@@ -1,0 +1,61 @@
+// cameraBufferToBgr: every layout the camera backends receive becomes the right BGR pixels, strides are
+// honoured, and short or undecodable buffers give an empty image (which the backends count as skipped).
+#include <catch2/catch.hpp>
+
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "camera_pixels.hpp"
+
+using toposlam::CameraPixelLayout;
+using toposlam::cameraBufferToBgr;
+using toposlam::packedImageBytes;
+
+SCENARIO("GIVEN 2x2 packed buffers with a padded stride WHEN converted THEN the BGR pixels are exact") {
+  // Rows 8 bytes apart; the last row is not padded (what packedImageBytes expects at least).
+  const std::vector<std::uint8_t> rgb = {10, 20, 30, 40, 50, 60, 0, 0, 70, 80, 90, 100, 110, 120};
+  const cv::Mat from_rgb = cameraBufferToBgr(CameraPixelLayout::Rgb, rgb.data(), rgb.size(), 2, 2, 8);
+  REQUIRE(from_rgb.type() == CV_8UC3);
+  CHECK(from_rgb.at<cv::Vec3b>(0, 0) == cv::Vec3b(30, 20, 10));
+  CHECK(from_rgb.at<cv::Vec3b>(1, 1) == cv::Vec3b(120, 110, 100));
+  const cv::Mat from_bgr = cameraBufferToBgr(CameraPixelLayout::Bgr, rgb.data(), rgb.size(), 2, 2, 8);
+  CHECK(from_bgr.at<cv::Vec3b>(0, 1) == cv::Vec3b(40, 50, 60));
+  CHECK(from_bgr.data != rgb.data());  // a copy: the caller's buffer may be re-queued at once
+  const std::vector<std::uint8_t> grey = {0, 255, 9, 9, 128, 64};
+  const cv::Mat from_grey = cameraBufferToBgr(CameraPixelLayout::Grey, grey.data(), grey.size(), 2, 2, 4);
+  CHECK(from_grey.at<cv::Vec3b>(0, 1) == cv::Vec3b(255, 255, 255));
+  CHECK(from_grey.at<cv::Vec3b>(1, 0) == cv::Vec3b(128, 128, 128));
+  // YUYV with neutral chroma (U = V = 128): grey at the luma of each pixel (BT.601 video range).
+  const std::vector<std::uint8_t> yuyv = {16, 128, 235, 128, 16, 128, 235, 128};
+  const cv::Mat from_yuyv = cameraBufferToBgr(CameraPixelLayout::Yuyv, yuyv.data(), yuyv.size(), 2, 2, 4);
+  REQUIRE(from_yuyv.size() == cv::Size(2, 2));
+  const cv::Vec3b dark = from_yuyv.at<cv::Vec3b>(0, 0), light = from_yuyv.at<cv::Vec3b>(1, 1);
+  CHECK(dark[0] == dark[2]);
+  CHECK(light[0] == light[2]);
+  CHECK(static_cast<int>(light[1]) - static_cast<int>(dark[1]) > 200);
+}
+
+SCENARIO("GIVEN short packed buffers WHEN converted THEN the image is empty") {
+  CHECK(packedImageBytes(CameraPixelLayout::Rgb, 2, 2, 8) == 14);
+  CHECK(packedImageBytes(CameraPixelLayout::Yuyv, 640, 480, 1280) == 614400);
+  CHECK(packedImageBytes(CameraPixelLayout::Rgb, 2, 2, 5) == 0);  // stride shorter than a row
+  const std::vector<std::uint8_t> bytes(13, 0);
+  CHECK(cameraBufferToBgr(CameraPixelLayout::Rgb, bytes.data(), bytes.size(), 2, 2, 8).empty());
+  CHECK(cameraBufferToBgr(CameraPixelLayout::Rgb, bytes.data(), bytes.size(), 2, 2, 5).empty());
+}
+
+SCENARIO("GIVEN JPEG buffers WHEN converted THEN a valid one decodes and garbage or nothing gives empty") {
+  cv::Mat image(16, 24, CV_8UC3, cv::Scalar(200, 100, 50));
+  std::vector<std::uint8_t> jpeg;
+  REQUIRE(cv::imencode(".jpg", image, jpeg));
+  const cv::Mat decoded = cameraBufferToBgr(CameraPixelLayout::Jpeg, jpeg.data(), jpeg.size(), 0, 0, 0);
+  REQUIRE(decoded.size() == cv::Size(24, 16));
+  const cv::Vec3b pixel = decoded.at<cv::Vec3b>(8, 12);
+  CHECK(std::abs(pixel[0] - 200) <= 3);
+  CHECK(std::abs(pixel[1] - 100) <= 3);
+  CHECK(std::abs(pixel[2] - 50) <= 3);
+  const std::vector<std::uint8_t> garbage(64, 0x5a);
+  CHECK(cameraBufferToBgr(CameraPixelLayout::Jpeg, garbage.data(), garbage.size(), 0, 0, 0).empty());
+  CHECK(cameraBufferToBgr(CameraPixelLayout::Jpeg, jpeg.data(), 0, 0, 0, 0).empty());
+}
