@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets up, builds and runs the whole test suite: a Release build, then (in CI, or with
-# TOPOSLAM_SANITIZERS=1) a second build under AddressSanitizer + UndefinedBehaviorSanitizer.
+# TOPOSLAM_SANITIZERS=1) a second build under AddressSanitizer + UndefinedBehaviorSanitizer and a third,
+# smaller one under ThreadSanitizer for the code that owns threads (pipeline, queues, worker pool).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -18,4 +19,13 @@ if [ "${CI:-}" = "true" ] || [ "${TOPOSLAM_SANITIZERS:-0}" = "1" ]; then
     -DTOPOSLAM_WERROR=ON
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs" -LE "slow|vm|browser" ${CTEST_ARGS:-}
+
+  echo "== thread sanitizer build and tests (pipeline, queues, worker pool)"
+  # Only the targets whose code owns threads: OpenCV's own TBB threads are not instrumented, so TSan
+  # cannot judge code that runs inside OpenCV's parallel loops (docs/architecture.md, "Sanitizers").
+  BUILD_TYPE=RelWithDebInfo BUILD_TARGETS="test_pipeline test_core" \
+    scripts/build.sh "$root/build-tsan" -DTOPOSLAM_SANITIZE=thread -DTOPOSLAM_WERROR=ON
+  # Tests of the targets not built here are registered as *_NOT_BUILT: leave them out.
+  TSAN_OPTIONS=halt_on_error=1 ctest --test-dir "$root/build-tsan" --output-on-failure -j "$jobs" -E "_NOT_BUILT" \
+    -LE "slow|vm|browser|e2e|cli" ${CTEST_ARGS:-}
 fi

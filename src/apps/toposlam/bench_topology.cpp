@@ -13,7 +13,7 @@
 
 #include "bench_stats.hpp"
 #include "commands.hpp"
-#include "sample_frames.hpp"
+#include "image_input.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"

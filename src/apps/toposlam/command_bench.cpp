@@ -8,7 +8,7 @@
 
 #include "bench_stats.hpp"
 #include "commands.hpp"
-#include "sample_frames.hpp"
+#include "image_input.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 

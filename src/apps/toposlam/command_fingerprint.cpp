@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "commands.hpp"
-#include "sample_frames.hpp"
+#include "image_input.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"

@@ -17,7 +17,7 @@
 #include <stdexcept>
 
 #include "commands.hpp"
-#include "sample_frames.hpp"
+#include "image_input.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/labelled_image_list.hpp"

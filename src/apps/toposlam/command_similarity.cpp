@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "commands.hpp"
-#include "sample_frames.hpp"
+#include "image_input.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"

@@ -1,5 +1,5 @@
 // Image input for the CLI commands and sample frames for benchmarks: see the header.
-#include "sample_frames.hpp"
+#include "image_input.hpp"
 
 #include <cstdlib>
 #include <filesystem>
