@@ -5,6 +5,7 @@
 #include <bit>
 #include <cstddef>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -66,6 +67,18 @@ void packBinaryRows(const cv::Mat& rows, int words, std::vector<std::uint64_t>& 
 void keypointRange(const Subregion& s, int rows, int& begin, int& end) {
   begin = std::clamp(s.keypoint_begin, 0, rows);
   end = std::clamp(s.keypoint_end, begin, rows);
+}
+
+// Histogram distances closer than this are equally good (rounding of identical histograms).
+constexpr double kHistogramTie = 1e-6;
+
+// Tie-break cost of pairing letter `own` (of `own_letters`) with candidate letter `other` (of
+// `other_letters`); lower wins. With a preferred candidate (the one that continues the previous letter's
+// correspondence, -1 if none) the distance to it, else the distance to the same relative position,
+// |own / own_letters - other / other_letters| scaled to integers. Equal costs keep the earlier candidate.
+long orderCost(int own, int other, int own_letters, int other_letters, int preferred) {
+  if (preferred >= 0) return std::labs(static_cast<long>(other) - preferred);
+  return std::labs(static_cast<long>(other) * own_letters - static_cast<long>(own) * other_letters);
 }
 
 }  // namespace
@@ -154,21 +167,29 @@ void NgramMatcher::matchHistograms(const Fingerprint& reference, const Fingerpri
     s.query_histogram_empty[i] =
         sqrtHistogram(query.subregions[i].histogram, &s.query_sqrt_histograms[i * kHistogramBins]) ? 0 : 1;
   }
-  // For every reference histogram, its best query histogram (ties: the leftmost), if close enough.
+  // For every reference histogram, its best query histogram, if close enough. Equally good candidates
+  // (within kHistogramTie) resolve to the order-consistent one: the letter after the previous reference
+  // letter's partner, else the one at the same relative position (see orderCost).
+  int previous_partner = -1;
   for (int j = 0; j < m; ++j) {
     double best = std::numeric_limits<double>::infinity();
     int best_letter = -1;
+    long best_cost = 0;
     for (int i = 0; i < q; ++i) {
       const double d = hellingerFromSqrt(&s.reference_sqrt_histograms[j * kHistogramBins],
                                          s.reference_histogram_empty[j] != 0,
                                          &s.query_sqrt_histograms[i * kHistogramBins], s.query_histogram_empty[i] != 0);
-      if (d < best) {
-        best = d;
+      const long cost = orderCost(j, i, m, q, previous_partner < 0 ? -1 : previous_partner + 1);
+      if (d < best - kHistogramTie || (d <= best + kHistogramTie && cost < best_cost)) {
+        best = std::min(best, d);
         best_letter = i;
+        best_cost = cost;
       }
     }
+    previous_partner = -1;
     if (best_letter >= 0 && best <= config_.max_hellinger_distance) {
       s.histogram_scores[static_cast<std::size_t>(j) * q + best_letter] = static_cast<float>(1.0 - best);
+      previous_partner = best_letter;
     }
   }
 }
@@ -212,25 +233,93 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
   resizeFor(s.last_query_letter, static_cast<std::size_t>(rd.rows), -1);
   resizeFor(s.pair_matches, cells, 0);
 
+  // Distance of query keypoint k to reference keypoint r, in the kernel's units (ties only: not hot).
+  const auto distance = [&](int k, int r) -> float {
+    if (rd.depth() == CV_8U) {
+      const int words = (rd.cols + 7) / 8;
+      const std::uint64_t* a = s.query_words.data() + static_cast<std::ptrdiff_t>(k) * words;
+      const std::uint64_t* b = s.reference_words.data() + static_cast<std::ptrdiff_t>(r) * words;
+      int bits = 0;
+      for (int w = 0; w < words; ++w) bits += std::popcount(a[w] ^ b[w]);
+      return static_cast<float>(bits);
+    }
+    const float* a = qd.ptr<float>(k);
+    const float* b = rd.ptr<float>(r);
+    float squared = 0.f;
+    for (int c = 0; c < rd.cols; ++c) squared += (a[c] - b[c]) * (a[c] - b[c]);
+    return std::sqrt(squared);
+  };
+  // Keeps a match that passed the tests: each reference keypoint counts once per letter pair.
   int kept = 0;
+  const auto keep = [&](int r, int i) {
+    ++kept;
+    const int j = s.reference_letter_of_keypoint[r];
+    if (j < 0 || s.last_query_letter[r] == i) return;
+    s.last_query_letter[r] = i;
+    ++s.pair_matches[static_cast<std::size_t>(j) * q + i];
+  };
+  // The reference letter query letter i matched most (ties: the earlier), -1 if none.
+  const auto partnerOf = [&](int i) {
+    int partner = -1;
+    int most = 0;
+    for (int j = 0; j < m; ++j) {
+      const int count = s.pair_matches[static_cast<std::size_t>(j) * q + i];
+      if (count > most) {
+        most = count;
+        partner = j;
+      }
+    }
+    return partner;
+  };
+
+  int previous_partner = -1;
   for (int i = 0; i < q; ++i) {
     int begin = 0;
     int end = 0;
     keypointRange(query.subregions[i], qd.rows, begin, end);
+    // Pass 1: unambiguous best matches. A best distance shared by several reference keypoints
+    // (second == best) waits for pass 2.
     for (int k = begin; k < end; ++k) {
       const DescriptorMatch& match = s.matches[k];
-      if (match.reference_keypoint < 0) continue;
+      if (match.reference_keypoint < 0 || match.second_distance == match.distance) continue;
       if (!(match.distance <= max_distance)) continue;
       if (config_.ratio_test < 1.0 &&
           !(static_cast<double>(match.distance) <= config_.ratio_test * match.second_distance))
         continue;
-      ++kept;
-      const int r = match.reference_keypoint;
-      const int j = s.reference_letter_of_keypoint[r];
-      if (j < 0 || s.last_query_letter[r] == i) continue;  // count each reference keypoint once per pair
-      s.last_query_letter[r] = i;
-      ++s.pair_matches[static_cast<std::size_t>(j) * q + i];
+      keep(match.reference_keypoint, i);
     }
+    // Pass 2: equally good candidates resolve to the order-consistent one: in the reference letter this
+    // query letter already matched, else the one after the previous query letter's partner, else the same
+    // relative position; within that letter, the keypoint at the same offset. The tests are unchanged:
+    // a tie fails the ratio test unless its distance is 0 (duplicated descriptors) or the test is off.
+    const int own_partner = partnerOf(i);
+    const int preferred = own_partner >= 0 ? own_partner : previous_partner >= 0 ? previous_partner + 1 : -1;
+    for (int k = begin; k < end; ++k) {
+      const DescriptorMatch& match = s.matches[k];
+      if (match.reference_keypoint < 0 || match.second_distance != match.distance) continue;
+      if (!(match.distance <= max_distance)) continue;
+      if (config_.ratio_test < 1.0 &&
+          !(static_cast<double>(match.distance) <= config_.ratio_test * match.second_distance))
+        continue;
+      int chosen = -1;
+      long chosen_letter_cost = 0;
+      int chosen_offset_cost = 0;
+      for (int r = 0; r < rd.rows; ++r) {
+        if (distance(k, r) != match.distance) continue;
+        const int j = s.reference_letter_of_keypoint[r];
+        const long letter_cost = j < 0 ? std::numeric_limits<long>::max() : orderCost(i, j, q, m, preferred);
+        const int offset_cost =
+            j < 0 ? 0 : std::abs((r - reference.subregions[j].keypoint_begin) - (k - begin));
+        if (chosen < 0 || letter_cost < chosen_letter_cost ||
+            (letter_cost == chosen_letter_cost && offset_cost < chosen_offset_cost)) {
+          chosen = r;
+          chosen_letter_cost = letter_cost;
+          chosen_offset_cost = offset_cost;
+        }
+      }
+      keep(chosen, i);
+    }
+    previous_partner = partnerOf(i);
   }
   for (int j = 0; j < m; ++j) {
     const int own = reference.subregions[j].keypointCount();

@@ -141,6 +141,29 @@ SCENARIO("Figure 3.9: three unigrams, two bigrams and one trigram for both featu
   }
 }
 
+SCENARIO("Equally good candidates resolve to the order-consistent letter") {
+  GIVEN("four letters with the same histogram and the same two descriptors, then a distinct fifth") {
+    std::mt19937_64 rng(4);
+    const cv::Mat block = randomRows(2, 32, rng);
+    const Fingerprint f = makeFingerprint({oneHot(3), oneHot(3), oneHot(3), oneHot(3), oneHot(7)},
+                                          {block, block, block, block, randomRows(2, 32, rng)});
+    REQUIRE(f.validate().empty());
+    WHEN("the fingerprint is counted against itself") {
+      const NgramCounts c = NgramMatcher().counts(f, f);
+      THEN("every letter pairs with itself: all 5 unigrams, 4 bigrams and 3 trigrams count fully") {
+        // Ties to the leftmost letter and earliest keypoint gave histogram counts 5, 0, 0 and keypoint 2, 0, 0.
+        CHECK(c.histogram[0] == Approx(5.0));
+        CHECK(c.histogram[1] == Approx(4.0));
+        CHECK(c.histogram[2] == Approx(3.0));
+        CHECK(c.keypoint[0] == Approx(5.0));
+        CHECK(c.keypoint[1] == Approx(4.0));
+        CHECK(c.keypoint[2] == Approx(3.0));
+        CHECK(c.matched_keypoints == 10);
+      }
+    }
+  }
+}
+
 SCENARIO("Similarity: self, symmetry and degenerate fingerprints") {
   Figure39 example;
   NgramSimilarity similarity;

@@ -3,10 +3,12 @@
 //
 // Each subregion is a "letter". For a (reference, query) pair the engine
 //   1. matches histograms: for every reference letter j, the query letter i with the smallest normalised
-//      Hellinger distance d; kept if d <= max_hellinger_distance, letter score 1 - d;
+//      Hellinger distance d; kept if d <= max_hellinger_distance, letter score 1 - d (equal distances:
+//      the letter after the previous reference letter's partner, else the same relative position);
 //   2. matches keypoints: for every query keypoint, its best match among all the reference's keypoints
 //      (Hamming distance for binary descriptors, L2 for float ones), kept if it passes the optional
-//      distance and ratio tests. Reference letter j and query letter i correspond when at least one
+//      distance and ratio tests (a best distance shared by several reference keypoints goes to the
+//      order-consistent one, see docs/matching.md). Reference letter j and query letter i correspond when at least one
 //      keypoint of i matched a keypoint of j; the pair's score is the number of distinct keypoints of j
 //      matched from i over the number of keypoints in j;
 //   3. counts n-grams (n = 1, 2, 3) separately for histograms and keypoints: an n-gram is n consecutive
