@@ -39,7 +39,17 @@ if mount -t 9p -o trans=virtio,version=9p2000.L,ro,cache=loose,msize=512000 host
   mount -t proc proc /host/proc
   mount -t sysfs sys /host/sys
   mount -t devtmpfs dev /host/dev
+  # /tmp in the guest is a writable tmpfs; a checkout or build folder under the host's /tmp (CI clones
+  # may live there) is bound back over it so the guest still sees the project.
+  mkdir -p /hosttmp
+  mount -o bind /host/tmp /hosttmp
   mount -t tmpfs tmp /host/tmp
+  for dir in "${tsguest%/tests/vm/guest.sh}" "$tsbuild"; do
+    case "$dir" in
+      /tmp/?*) mkdir -p "/host$dir" && mount -o bind "/hosttmp${dir#/tmp}" "/host$dir" ||
+                 echo "VMTEST FAIL cannot bind $dir over the guest's /tmp" ;;
+    esac
+  done
   mount -t tmpfs run /host/run
   echo "VMTEST BOOTED [$(cut -d" " -f1 /proc/uptime) s]"
   chroot /host /bin/sh "$tsguest" "$tsbuild"
