@@ -55,6 +55,12 @@ class BinaryReader {
       v |= static_cast<std::uint64_t>(static_cast<std::uint8_t>(data_[pos_++])) << (8 * i);
     return v;
   }
+  /// A flag stored as one byte, 0 or 1; anything else is damage, refused rather than read as "true".
+  bool flag(const char* what) {
+    const std::uint8_t v = u8(what);
+    if (v > 1) throw std::runtime_error(std::string("map data has a damaged flag in ") + what);
+    return v == 1;
+  }
   std::int32_t i32(const char* what) { return static_cast<std::int32_t>(u32(what)); }
   std::int64_t i64(const char* what) { return static_cast<std::int64_t>(u64(what)); }
   double f64(const char* what) { return std::bit_cast<double>(u64(what)); }

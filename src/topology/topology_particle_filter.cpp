@@ -535,7 +535,7 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
   config.gamma_scale = r.f64("config");
   config.max_successors = r.i32("config");
   config.max_representatives_per_node = r.i32("config");
-  config.forbid_return_to_previous = r.u8("config") != 0;
+  config.forbid_return_to_previous = r.flag("config");
   config.seed = r.u64("config");
   if (const std::string problem = config.validate(); !problem.empty()) {
     throw std::runtime_error("map data has an invalid filter config: " + problem);
