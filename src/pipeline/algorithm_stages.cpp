@@ -21,24 +21,33 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, std::s
   SegmenterStep step = segmenter_.addFrame(sequence, static_cast<double>(sequence), std::move(fingerprint));
   SegmentationStep out;
   if (step.lambda2) out.lambda2 = *step.lambda2;
-  if (step.closed_place) {
-    const SegmentedPlace& p = *step.closed_place;
-    if (p.dropped) {
-      ++dropped_places_;
-    } else {
-      ClosedPlace place;
-      place.place = static_cast<int>(p.index);
-      place.first_frame = p.first_frame;
-      place.last_frame = p.last_frame;
-      place.representative_frame = p.representative_frame;
-      place.keypoints = p.representative_keypoints;
-      place.representative = p.representative;
-      if (auto it = thumbnails_.find(p.representative_frame); it != thumbnails_.end()) place.thumbnail = it->second;
-      out.closed = std::move(place);
-    }
-    // Frames up to the closed place's end are no longer needed.
-    thumbnails_.erase(thumbnails_.begin(), thumbnails_.upper_bound(p.last_frame));
+  if (step.closed_place) out.closed = toClosedPlace(*step.closed_place);
+  return out;
+}
+
+std::optional<ClosedPlace> FiedlerSegmentationStage::finish() {
+  const std::optional<SegmentedPlace> last = segmenter_.flush();
+  if (!last) return std::nullopt;
+  return toClosedPlace(*last);
+}
+
+std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const SegmentedPlace& p) {
+  std::optional<ClosedPlace> out;
+  if (p.dropped) {
+    ++dropped_places_;
+  } else {
+    ClosedPlace place;
+    place.place = static_cast<int>(p.index);
+    place.first_frame = p.first_frame;
+    place.last_frame = p.last_frame;
+    place.representative_frame = p.representative_frame;
+    place.keypoints = p.representative_keypoints;
+    place.representative = p.representative;
+    if (auto it = thumbnails_.find(p.representative_frame); it != thumbnails_.end()) place.thumbnail = it->second;
+    out = std::move(place);
   }
+  // Frames up to the closed place's end are no longer needed.
+  thumbnails_.erase(thumbnails_.begin(), thumbnails_.upper_bound(p.last_frame));
   return out;
 }
 

@@ -289,13 +289,17 @@ void Pipeline::fingerprintLoop() {
 
 void Pipeline::segmentationLoop() {
   try {
+    bool input_ended = false;
     for (;;) {
       Fingerprinted in;
       setWaiting(kSegmentation, true);
       QueueWait wait = fingerprints_->popFor(in, kPollPeriod);
       beat(kSegmentation);
       setWaiting(kSegmentation, false);
-      if (wait == QueueWait::Closed) break;
+      if (wait == QueueWait::Closed) {
+        input_ended = true;
+        break;
+      }
       if (wait == QueueWait::Timeout) continue;
       const double t0 = clock_.now();
       SegmentationStep step = segmentation_.process(in.result.sequence, std::move(in.fingerprint), in.thumbnail);
@@ -304,6 +308,16 @@ void Pipeline::segmentationLoop() {
       in.result.segmentation_ms = (clock_.now() - t0) * 1e3;
       if (!forward(*segmented_, std::move(in.result))) break;
       processed_[kSegmentation].fetch_add(1);
+    }
+    // End of stream (not a stop: a resumed run goes on in the same place): the open place closes too,
+    // on a record without a frame.
+    if (input_ended && !stop_requested_.load()) {
+      if (std::optional<ClosedPlace> last = segmentation_.finish()) {
+        FrameResult flush;
+        flush.has_frame = false;
+        flush.closed_place = std::move(last);
+        segmented_->pushWait(std::move(flush));
+      }
     }
   } catch (const std::exception& e) {
     recordError(std::string("segmentation: ") + e.what());

@@ -131,6 +131,8 @@ class FakeSegmentation final : public SegmentationStage {
     if (after_frame) after_frame(sequence);
     SegmentationStep step;
     step.lambda2 = static_cast<double>(sequence);
+    last_sequence_ = sequence;
+    last_fingerprint_ = fingerprint;
     if ((sequence + 1) % period_ == 0) {
       ClosedPlace p;
       p.place = closed++;
@@ -143,12 +145,27 @@ class FakeSegmentation final : public SegmentationStage {
     }
     return step;
   }
+  /// Closes the frames since the last full block as one (shorter) place.
+  std::optional<ClosedPlace> finish() override {
+    ++finish_calls;
+    if (last_sequence_ < 0 || (last_sequence_ + 1) % period_ == 0) return std::nullopt;
+    ClosedPlace p;
+    p.place = closed++;
+    p.first_frame = last_sequence_ - last_sequence_ % period_;
+    p.last_frame = last_sequence_;
+    p.representative_frame = last_sequence_;
+    p.representative = last_fingerprint_;
+    return p;
+  }
   int closed = 0;
+  int finish_calls = 0;
   std::int64_t throw_at = -1;
   std::function<void(std::int64_t)> after_frame;  ///< called with each frame's sequence
 
  private:
   int period_;
+  std::int64_t last_sequence_ = -1;
+  std::shared_ptr<const Fingerprint> last_fingerprint_;
 };
 
 class FakeTopology final : public TopologyStage {

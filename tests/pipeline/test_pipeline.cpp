@@ -174,6 +174,39 @@ SCENARIO("requestStop() finishes the filter steps in progress and saves the map 
         CHECK(pipeline.error().empty());
         CHECK(pipeline.finished());
       }
+      THEN("the open place is not closed: a resumed run goes on in it") { CHECK(segmentation.finish_calls == 0); }
+    }
+  }
+}
+
+SCENARIO("GIVEN a stream that ends inside a place WHEN it ends THEN that last place is closed and mapped too") {
+  GIVEN("95 frames and a place every 10 frames: 9 full places, then frames 90..94") {
+    ManualClock clock;
+    FakeSource source(95);
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(10);
+    FakeTopology topology(clock, 5, 1e-3);
+    RecordingSink sink;
+    {
+      Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+      pipeline.start();
+      pipeline.wait();
+      REQUIRE(pipeline.error().empty());
+    }
+    THEN("10 places get their filter step, the last one spanning frames 90..94, and every frame is published") {
+      CHECK(segmentation.finish_calls == 1);
+      std::vector<ClosedPlace> finished;
+      int frames = 0;
+      for (const FrameResult& r : sink.results) {
+        frames += r.has_frame ? 1 : 0;
+        for (const auto& [place, assignment] : r.finished_places) finished.push_back(place);
+      }
+      CHECK(frames == 95);
+      REQUIRE(finished.size() == 10);
+      CHECK(finished.back().place == 9);
+      CHECK(finished.back().first_frame == 90);
+      CHECK(finished.back().last_frame == 94);
+      CHECK(topology.saved_at_revision.back() == 10);
     }
   }
 }

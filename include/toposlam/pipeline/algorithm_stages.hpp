@@ -40,9 +40,14 @@ class FiedlerSegmentationStage final : public SegmentationStage {
                            std::size_t max_thumbnails = 600);
   SegmentationStep process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
                            const cv::Mat& thumbnail) override;
+  std::optional<ClosedPlace> finish() override;
   std::int64_t droppedPlaces() const { return dropped_places_; }
 
  private:
+  /// The pipeline's record of a place the segmenter closed (nullopt when it was dropped); frees the
+  /// thumbnails of its frames.
+  std::optional<ClosedPlace> toClosedPlace(const SegmentedPlace& place);
+
   FiedlerSegmenter segmenter_;
   std::size_t max_thumbnails_;
   std::map<std::int64_t, cv::Mat> thumbnails_;  ///< frame -> thumbnail, frames of the open place

@@ -100,6 +100,9 @@ class SegmentationStage {
   /// representing); the stage may keep it (cv::Mat shares, no copy).
   virtual SegmentationStep process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
                                    const cv::Mat& thumbnail) = 0;
+  /// Called once when the stream has ended (not on a stop request, after which a resumed run goes on
+  /// in the same place): closes the open place, if it is kept.
+  virtual std::optional<ClosedPlace> finish() = 0;
 };
 
 /// A copy of the map taken at one moment (in memory, cheap), written to disk later by another thread so
