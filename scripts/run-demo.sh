@@ -59,8 +59,8 @@ echo
 echo "== 2/2 offline: the same route with ground truth -> map, accuracy, report"
 "$toposlam" sim office --route loop2 --out "$out/sim"
 "$toposlam" map "images:$out/sim/frames" --out "$out/map"
-"$toposlam" eval "$out/map" --truth "$out/sim/labels.csv" --traversals 2
-"$toposlam" report "$out/map" --truth "$out/sim/labels.csv" --traversals 2 --frames "$out/sim/frames" \
+"$toposlam" eval "$out/map" --truth "$out/sim/labels.csv"
+"$toposlam" report "$out/map" --truth "$out/sim/labels.csv" --frames "$out/sim/frames" \
   --out "$out/report.html"
 
 echo
