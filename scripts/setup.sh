@@ -8,7 +8,8 @@ PACKAGES=(
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
   graphviz
   chromium chromium-driver python3  # browser check of `toposlam report` over WebDriver (ctest -L browser)
-  qemu-system-x86 busybox-static cpio kmod v4l-utils ffmpeg iproute2  # VM camera test (tests/vm)
+  qemu-system-x86 busybox-static cpio kmod xz-utils v4l-utils ffmpeg iproute2  # VM camera test (tests/vm)
+  libcamera-ipa libcamera-tools  # VM test: libcamera's vimc IPA module, `cam --list` (tests/vm)
 )
 
 SUDO=""

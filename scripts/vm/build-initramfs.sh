@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the VM test's initramfs: a static busybox, the kernel modules prepared by prepare.sh (in load
-# order) and an /init that loads them (videodev, vivid, v4l2loopback, 9p), mounts the host's root
+# order) and an /init that loads them (videodev, vivid, v4l2loopback, vimc, 9p), mounts the host's root
 # read-only over 9p at /host, and runs the guest script given on the kernel command line
 # (tsguest=/path/guest.sh tsbuild=/path/build) inside `chroot /host`, then powers off.
 # Usage: scripts/vm/build-initramfs.sh CACHE_DIR OUTPUT.cpio.gz

@@ -6,7 +6,9 @@
 #      and carries on;
 #   2. v4l2loopback fed the bundled frames as YUYV by ffmpeg: `toposlam capture` receives frames with
 #      increasing sequence numbers and monotonic timestamps;
-#   3. toposlamd on the loopback device, publishing over LCM on lo, checked by a subscriber (a missing
+#   3. libcamera (tests/vm/guest-libcamera.sh, beside 2.): `toposlam capture libcamera:ID` on the kernel's
+#      vimc camera through libcamera's vimc pipeline handler: 30 frames of the size asked for;
+#   4. toposlamd on the loopback device, publishing over LCM on lo, checked by a subscriber (a missing
 #      toposlamd binary is a failure, not a skip).
 # Prints "VMTEST PASS|FAIL <what>" lines for tests/vm/run-vm-test.sh, then "VMTEST DONE failures=N".
 # Usage (from the initramfs init): guest.sh BUILD_DIR
@@ -87,8 +89,10 @@ else
   fi
 fi
 
-# --- v4l2loopback, YUYV from ffmpeg ---------------------------------------------------------------------
-step "loopback yuyv"
+# --- libcamera on vimc (in the background) and v4l2loopback, YUYV from ffmpeg ---------------------------
+step "libcamera on vimc (background), loopback yuyv"
+. "$(dirname "$0")/guest-libcamera.sh"
+libcamera_start
 if wait_for_writer YUYV; then
   timeout 60 "$toposlam" capture "v4l2:/dev/video0?size=320x240&fps=10&format=yuyv" -n 30 --timeout 45 \
     >loop-yuyv.txt 2>&1
@@ -97,6 +101,7 @@ if wait_for_writer YUYV; then
 else
   fail "v4l2loopback yuyv: the ffmpeg writer never set a format"
 fi
+libcamera_check
 
 # --- toposlamd over LCM, on the same loopback camera ----------------------------------------------------
 if [ -x "$toposlamd" ]; then

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The VM test (ctest label `vm`): boots Debian's own kernel under QEMU (TCG, no KVM needed), with
-# v4l2loopback and vivid loaded, shares this machine's root read-only over 9p and runs the real
+# v4l2loopback, vivid and vimc loaded, shares this machine's root read-only over 9p and runs the real
 # toposlam binaries from BUILD_DIR inside (tests/vm/guest.sh). Passes when every guest check passed.
 # Exit 77 (skipped) only when QEMU cannot run here at all (no qemu-system-x86_64).
 # The whole test (prepare + boot + guest) must finish within TOPOSLAM_VM_BUDGET seconds (default 175; ctest
@@ -23,7 +23,7 @@ if [ -z "$qemu" ]; then
   echo "vm-test: SKIPPED: qemu-system-x86_64 is not installed (scripts/setup.sh installs qemu-system-x86)"
   exit 77
 fi
-for tool in busybox cpio modprobe depmod dpkg-deb make gcc; do
+for tool in busybox cpio modprobe depmod dpkg-deb make gcc xz; do
   command -v "$tool" >/dev/null || [ -x "/bin/$tool" ] || [ -x "/sbin/$tool" ] ||
     { echo "vm-test: FAILED: $tool missing (run scripts/setup.sh)"; exit 1; }
 done
