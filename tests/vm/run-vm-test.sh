@@ -3,8 +3,9 @@
 # v4l2loopback, vivid and vimc loaded, shares this machine's root read-only over 9p and runs the real
 # toposlam binaries from BUILD_DIR inside (tests/vm/guest.sh). Passes when every guest check passed.
 # Exit 77 (skipped) only when QEMU cannot run here at all (no qemu-system-x86_64).
-# The whole test (prepare + boot + guest) must finish within TOPOSLAM_VM_BUDGET seconds (default 175; ctest
-# stops it at 180): the VM gets what the preparation left of it, and a test over budget fails.
+# The whole test (boot + guest, plus preparing the cache when ctest's vm_prepare_kernel fixture did not
+# already) must finish within TOPOSLAM_VM_BUDGET seconds (default 175; ctest stops it at 180): the VM gets
+# what the preparation left of it, and a test over budget fails.
 # Usage: tests/vm/run-vm-test.sh BUILD_DIR [CACHE_DIR]    (CACHE_DIR default BUILD_DIR/vm-cache)
 # Environment: TOPOSLAM_VM_BUDGET (seconds for the whole test, default 175),
 #              TOPOSLAM_VM_TIMEOUT (seconds for boot-to-poweroff, default: what is left of the budget),
