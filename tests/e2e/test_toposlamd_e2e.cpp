@@ -14,7 +14,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <set>
 #include <string>
@@ -157,12 +156,17 @@ std::int64_t representativeOf(const ReceivedMessage& m) {
 }
 
 /// Place -> node of a TOPOSLAM_TOPOLOGY message, from its JSON ("nodes":[{"id":N,"places":[...]},...]).
+/// (A plain scan: GCC 12 with sanitizers warns falsely inside std::regex.)
 std::map<int, int> nodesOfPlaces(const ReceivedMessage& topology) {
   std::map<int, int> node_of_place;
-  const std::regex node_pattern("\\{\"id\":(-?[0-9]+),\"places\":\\[([0-9,]*)\\]");
-  for (std::sregex_iterator it(topology.json.begin(), topology.json.end(), node_pattern), end; it != end; ++it) {
-    const int node = std::stoi((*it)[1].str());
-    std::istringstream places((*it)[2].str());
+  const std::string& json = topology.json;
+  const std::string id_key = "{\"id\":", places_key = ",\"places\":[";
+  for (std::size_t at = json.find(id_key); at != std::string::npos; at = json.find(id_key, at + 1)) {
+    const std::size_t id_end = json.find(places_key, at);
+    if (id_end == std::string::npos) break;
+    const int node = std::stoi(json.substr(at + id_key.size(), id_end - at - id_key.size()));
+    const std::size_t list = id_end + places_key.size();
+    std::istringstream places(json.substr(list, json.find(']', list) - list));
     for (std::string place; std::getline(places, place, ',');) node_of_place[std::stoi(place)] = node;
   }
   return node_of_place;
