@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
@@ -113,13 +114,16 @@ bool imageBytesLookComplete(const std::vector<unsigned char>& bytes) {
   return true;  // unknown format: let the decoder decide
 }
 
-ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz)
-    : origin_(path_or_glob), files_(listImageFiles(path_or_glob)), rate_hz_(timestamp_rate_hz) {
+ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz, bool rate_given)
+    : origin_(path_or_glob), files_(listImageFiles(path_or_glob)), rate_hz_(timestamp_rate_hz), rate_given_(rate_given) {
   if (!(rate_hz_ > 0)) throw FrameSourceError("images: rate must be > 0 Hz");
 }
 
 std::string ImageFilesSource::describe() const {
-  return "images:" + origin_ + " (" + std::to_string(files_.size()) + " frames)";
+  std::ostringstream rate;
+  rate << rate_hz_;
+  return "images:" + origin_ + " (" + std::to_string(files_.size()) + " frames, " +
+         (rate_given_ ? rate.str() + " fps" : "no frame rate given: timestamps at 1 fps, set ?fps=HZ") + ")";
 }
 
 std::optional<Frame> ImageFilesSource::next() {

@@ -84,9 +84,13 @@ class RateLimitedSource : public FrameSource {
 };
 
 std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
-  uri.requireOnly({});
+  uri.requireOnly({"fps"});
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': images: needs a folder, file or glob");
-  return std::make_unique<ImageFilesSource>(uri.path, uri.getDouble("rate", 1.0, 1e-3, 1e4));
+  // Frame timestamps (the segmentation window is in seconds): ?fps=HZ, else the real-time ?rate=HZ,
+  // else 1 Hz (the bundled keyframes' rate), said in describe() so a user sees the assumption.
+  const bool given = uri.has("fps") || uri.has("rate");
+  const double hz = uri.has("fps") ? uri.getDouble("fps", 1.0, 1e-3, 1e4) : uri.getDouble("rate", 1.0, 1e-3, 1e4);
+  return std::make_unique<ImageFilesSource>(uri.path, hz, given);
 }
 
 std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
@@ -101,7 +105,7 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, SchemeEntry> schemes;
   Registry() {
-    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?rate=HZ]"};
+    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ][&rate=HZ]"};
     schemes["video"] = {openVideo, "video:FILE[?rate=HZ]"};
     schemes["sim"] = {openSim,
                       "sim:WORLD?route=R&fps=F&size=WxH&seed=S[&speed=&fov=&light=day|night|warm|cool&noise=&people=&"

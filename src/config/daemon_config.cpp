@@ -1,5 +1,6 @@
 // DaemonConfig: YAML -> stage config structs, with strict key and range checking; see the header.
 #include "toposlam/config/daemon_config.hpp"
+#include "toposlam/config/method_preset.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -167,8 +168,20 @@ void readThread(Section& threads, const char* key, ThreadSettings& t) {
   s.finish();
 }
 
+// The method preset's stage settings (method_preset.hpp); keys that follow override them.
+void applyPreset(const MethodPreset& preset, DaemonConfig& c) {
+  c.preset = preset.name;
+  c.fingerprint = preset.fingerprint;
+  c.similarity = preset.similarity;
+  c.segmentation = preset.segmentation;
+  c.topology = preset.topology;
+}
+
 void readConfig(const YAML::Node& root, DaemonConfig& c) {
   Section top(root, "");
+  // The preset first: it gives every stage's defaults, the keys below override them.
+  const std::string preset = top.choice("preset", c.preset, {"default", "thesis"});
+  if (preset != c.preset) applyPreset(methodPreset(preset), c);
   top.text("source", c.source);
 
   {
@@ -263,13 +276,22 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     m.real("max_binary_distance_fraction", c.similarity.matcher.max_binary_distance_fraction, 0, 1, "", true);
     m.real("max_float_distance", c.similarity.matcher.max_float_distance, 0, 1e6, " (0 disables the test)");
     m.real("ratio_test", c.similarity.matcher.ratio_test, 0, 1, " (1 disables the test)", true);
+    m.flag("mutual_check", c.similarity.matcher.mutual_check);
+    m.real("max_angle_difference_deg", c.similarity.matcher.max_angle_difference_deg, 0, 180, " degrees (0 disables the test)");
     m.finish();
     s.real("histogram_weight", c.similarity.histogram_weight, 0, 1);
+    s.flag("histogram_gate", c.similarity.histogram_gate);
+    s.flag("histogram_only_fallback", c.similarity.histogram_only_fallback);
+    c.similarity.keypoint_scoring =
+        parseKeypointScoring(s.choice("keypoint_scoring", toString(c.similarity.keypoint_scoring),
+                                      {"possible-ngrams", "verified-matches"}));
     s.finish();
   }
   {
     Section s = top.child("segmentation");
+    s.real("window_s", c.segmentation.window_s, 0, 3600, " seconds (0 = a window of `window` frames)");
     s.integer("window", c.segmentation.window, 3, 1000, " frames");
+    s.integer("min_window_frames", c.segmentation.min_window_frames, 3, 1000, " frames (and <= window)");
     Section v = s.child("valley");
     v.real("gamma", c.segmentation.valley.gamma, 0, 2, " (and <= window / (window - 1))");
     v.real("delta", c.segmentation.valley.delta, 0, 2, " (and <= gamma)");
@@ -293,6 +315,11 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
   {
     Section t = top.child("topology");
     t.integer("particles", c.topology.particles, 1, 1000000);
+    c.topology.likelihood =
+        parseLikelihoodModel(t.choice("likelihood", toString(c.topology.likelihood), {"relative", "absolute"}));
+    t.real("relative_slope", c.topology.relative_slope, 0, 100, "", true);
+    t.real("relative_offset", c.topology.relative_offset, -10, 10);
+    t.real("relative_sigma_floor", c.topology.relative_sigma_floor, 0, 1, "", true);
     t.real("alpha", c.topology.alpha, 0, 1e6, "", true);
     t.real("new_node_probability", c.topology.new_node_probability, 0, 1, "", true, true);
     t.real("gamma_shape", c.topology.gamma_shape, 0, 1000, "", true);
@@ -316,7 +343,10 @@ std::string prefixed(const std::string& section, const std::string& problem) {
 
 }  // namespace
 
-DaemonConfig::DaemonConfig() { pipeline.map_path = "map.tsm"; }
+DaemonConfig::DaemonConfig() {
+  pipeline.map_path = "map.tsm";
+  applyPreset(methodPreset(preset), *this);
+}
 
 std::string DaemonConfig::validate() const {
   if (source.empty()) return "source: must not be empty (e.g. sim:office?route=loop2 or v4l2:/dev/video0)";

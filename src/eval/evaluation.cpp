@@ -1,6 +1,7 @@
 // Run folder + ground truth -> EvalResult, and its text / JSON / HTML forms (see evaluation.hpp).
 #include "toposlam/core/markup_escape.hpp"
 #include "toposlam/eval/evaluation.hpp"
+#include "toposlam/eval/recognition.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,6 +29,12 @@ RunData loadRun(const std::string& dir) {
                        ": missing; give a folder written by `toposlam segment` or `toposlam map`");
   }
   run.frames = loadFrames((root / "frames.csv").string());
+  {
+    std::ifstream header((root / "frames.csv").string());
+    std::string line;
+    std::getline(header, line);
+    run.has_frame_matches = (',' + line + ',').find(",match,") != std::string::npos;
+  }
   const auto frame_count = static_cast<std::int64_t>(run.frames.size());
   // Places must lie inside frames.csv (loadPlaces already checked 0 <= first <= representative <= last).
   auto loadPlacesWithin = [&](const std::string& name) {
@@ -173,9 +180,17 @@ LoopClosureMatrix matrixFromPairs(const Truth& truth, const RunData& run) {
   LoopClosureMatrix m;
   m.size = static_cast<int>(run.frames.size());
   m.same.assign(static_cast<std::size_t>(m.size) * static_cast<std::size_t>(m.size), 0);
+  std::vector<std::string> names;
+  for (const auto& f : run.frames) names.push_back(f.name);
   auto resolve = [&](const std::string& name, int line) {
     const auto it = frame_of_name.find(name);
     if (it != frame_of_name.end()) return it->second;
+    // A name with or without a folder: "41.jpg" finds "samples/41.jpg", "ref/7.jpg" finds "ref/7.jpg".
+    try {
+      if (const int f = resolveFrameName(name, names); f >= 0) return f;
+    } catch (const std::invalid_argument& e) {
+      throw RunFileError(truth.path + ":" + std::to_string(line) + ": " + e.what());
+    }
     throw RunFileError(truth.path + ":" + std::to_string(line) + ": frame '" + name + "' is not in " +
                        run.dir + "/frames.csv (column name)");
   };
@@ -256,6 +271,23 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
       lct = truthFromMatrix(m, result.min_gap);
     }
     result.loop_closure = precisionRecall(lct, pairsFromAssignments(node_of_frame, probability));
+    // Frame level (the literature's scoring), when frames.csv carries the detections of `map`.
+    if (run.has_frame_matches) {
+      std::vector<std::int64_t> match;
+      std::vector<double> score;
+      for (const auto& f : run.frames) {
+        match.push_back(f.match);
+        score.push_back(f.match_score);
+      }
+      const int gap = std::max(1, result.min_gap);
+      RecognitionTruth rt;
+      if (truth.kind == Truth::Kind::Labels) {
+        rt = sequenceTruthFromRooms(rooms, gap);
+      } else {
+        rt = sequenceTruthFromMatrix(truth.kind == Truth::Kind::Matrix ? truth.matrix : matrixFromPairs(truth, run), gap);
+      }
+      result.frame_loop_closure = frameLoopClosures(match, score, rt);
+    }
   } else {
     result.notes.push_back(
         "no topological nodes in frames.csv (a `segment` run?): no loop-closure or topology measures");
@@ -338,6 +370,26 @@ void writeEvalJson(std::ostream& out, const EvalResult& r) {
     json.field("average_precision", c.average_precision);
     json.key("curve").beginArray();
     for (const auto& p : c.points) {
+      json.beginObject()
+          .field("threshold", p.threshold)
+          .field("true_positives", p.true_positives)
+          .field("false_positives", p.false_positives)
+          .field("precision", p.precision)
+          .field("recall", p.recall)
+          .endObject();
+    }
+    json.endArray().endObject();
+  }
+  if (r.frame_loop_closure) {
+    const RecognitionScore& c = *r.frame_loop_closure;
+    json.key("frame_loop_closure").beginObject();
+    json.field("frames_with_match", c.queries_with_match).field("detections", c.detections);
+    json.field("right_detections", c.top1_correct);
+    json.field("recall_at_100_precision", c.recall_at_full_precision);
+    json.field("threshold_at_100_precision", c.threshold_at_full_precision);
+    json.field("average_precision", c.average_precision);
+    json.key("curve").beginArray();
+    for (const auto& p : c.curve) {
       json.beginObject()
           .field("threshold", p.threshold)
           .field("true_positives", p.true_positives)
@@ -456,6 +508,24 @@ std::vector<Table> tables(const EvalResult& r) {
       t.rows.push_back({"recall (all predictions)", percent(c.points.back().recall)});
     }
     t.rows.push_back({"average precision", fmt("%.3f", c.average_precision)});
+    out.push_back(t);
+  }
+  if (r.frame_loop_closure) {
+    const RecognitionScore& c = *r.frame_loop_closure;
+    const std::int64_t right = c.top1_correct;
+    Table t{"Frame-level loop closures (each frame's detected earlier frame, right when it is a true match at "
+            "least " + std::to_string(std::max(1, r.min_gap)) + " frames back; score: similarity x node probability)",
+            {"measure", "value"},
+            {}};
+    t.rows.push_back({"frames with a true match", std::to_string(c.queries_with_match)});
+    t.rows.push_back({"detections", std::to_string(c.detections)});
+    t.rows.push_back({"right detections", std::to_string(right)});
+    t.rows.push_back({"wrong detections", std::to_string(c.detections - right)});
+    t.rows.push_back({"recall at 100% precision", percent(c.recall_at_full_precision)});
+    if (!c.curve.empty()) {
+      t.rows.push_back({"precision (all detections)", percent(c.curve.back().precision)});
+      t.rows.push_back({"recall (all detections)", percent(c.curve.back().recall)});
+    }
     out.push_back(t);
   }
   if (r.boundaries) {

@@ -21,13 +21,43 @@ std::string trim(const std::string& s) {
   return s.substr(b, e - b);
 }
 
+// One CSV record: fields split at commas outside double quotes; a quoted field keeps its commas and line
+// breaks, with "" for a quote (RFC 4180). Unquoted fields are trimmed.
 std::vector<std::string> splitComma(const std::string& line) {
   std::vector<std::string> cells;
   std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  bool quoted = false, was_quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        cell += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        cell += c;
+      }
+    } else if (c == '"' && trim(cell).empty()) {
+      quoted = was_quoted = true;
+      cell.clear();
+    } else if (c == ',') {
+      cells.push_back(was_quoted ? cell : trim(cell));
+      cell.clear();
+      was_quoted = false;
+    } else {
+      cell += c;
+    }
+  }
+  cells.push_back(was_quoted ? cell : trim(cell));
   return cells;
+}
+
+// True while `record` has an unclosed quoted field (its line break belongs to the field).
+bool quoteOpen(const std::string& record) {
+  bool open = false;
+  for (char c : record) open = c == '"' ? !open : open;
+  return open;
 }
 
 std::string where(const CsvTable& t, std::size_t row) { return t.path + ":" + std::to_string(t.lines[row]); }
@@ -43,6 +73,12 @@ CsvTable readCsv(const std::string& path) {
   int line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    const int first_line = line_number;
+    std::string next;
+    while (quoteOpen(line) && std::getline(in, next)) {
+      ++line_number;
+      line += "\n" + next;
+    }
     if (trim(line).empty()) continue;
     std::vector<std::string> cells = splitComma(line);
     if (table.header.empty()) {
@@ -51,7 +87,7 @@ CsvTable readCsv(const std::string& path) {
     }
     if (cells.size() < table.header.size()) cells.resize(table.header.size());  // tolerate trailing empties
     table.rows.push_back(std::move(cells));
-    table.lines.push_back(line_number);
+    table.lines.push_back(first_line);
   }
   if (table.header.empty()) throw RunFileError(path + ":1: empty file, expected a header line");
   return table;
@@ -127,7 +163,9 @@ std::vector<LabelRow> loadLabels(const std::string& path) {
 std::vector<FrameRecord> loadFrames(const std::string& path) {
   const CsvTable t = readCsv(path);
   const int frame = t.column("frame"), time = t.column("time", false), name = t.column("name", false),
-            lambda2 = t.column("lambda2", false), place = t.column("place"), node = t.column("node", false);
+            lambda2 = t.column("lambda2", false), place = t.column("place"), node = t.column("node", false),
+            node_probability = t.column("node_probability", false), match = t.column("match", false),
+            match_score = t.column("match_score", false);
   std::vector<FrameRecord> rows;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     FrameRecord row;
@@ -143,6 +181,14 @@ std::vector<FrameRecord> loadFrames(const std::string& path) {
     row.node = node >= 0 && !t.rows[r][static_cast<std::size_t>(node)].empty()
                    ? static_cast<int>(t.integer(r, node))
                    : -1;
+    if (node_probability >= 0) row.node_probability = t.number(r, node_probability, true);
+    if (match >= 0 && !t.rows[r][static_cast<std::size_t>(match)].empty()) row.match = t.integer(r, match);
+    if (match_score >= 0) {
+      row.match_score = t.number(r, match_score, true);
+      if (std::isnan(row.match_score)) row.match_score = 0.0;
+    }
+    if (row.match >= row.frame)
+      throw RunFileError(where(t, r) + ": match " + std::to_string(row.match) + " is not an earlier frame");
     rows.push_back(std::move(row));
   }
   return rows;

@@ -35,11 +35,20 @@ template <typename Distance>
 
 // Best and second best reference row per query row. kWords > 0 fixes the row length at compile time
 // (the inner loop unrolls to kWords XOR + popcount); kWords == 0 takes it from `words` at run time.
+// With reference_best (and its scratch reference_best_distance, reference_count each), also the best
+// query row of every reference row (ties: the earlier query row), from the same distances.
 template <int kWords>
 [[gnu::always_inline]] inline void scanBinary(const std::uint64_t* query, int query_count,
                                               const std::uint64_t* reference, int reference_count,
-                                              int words, DescriptorMatch* out) {
+                                              int words, DescriptorMatch* out, int* reference_best,
+                                              int* reference_best_distance) {
   const int row_words = kWords > 0 ? kWords : words;
+  if (reference_best != nullptr) {
+    for (int r = 0; r < reference_count; ++r) {
+      reference_best[r] = -1;
+      reference_best_distance[r] = std::numeric_limits<int>::max();
+    }
+  }
   for (int q = 0; q < query_count; ++q) {
     const std::uint64_t* qrow = query + static_cast<std::ptrdiff_t>(q) * row_words;
     int best = std::numeric_limits<int>::max();
@@ -50,6 +59,10 @@ template <int kWords>
       int distance = 0;
       for (int w = 0; w < row_words; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
       consider(distance, r, best, second, best_row);
+      if (reference_best != nullptr && distance < reference_best_distance[r]) {
+        reference_best_distance[r] = distance;
+        reference_best[r] = q;
+      }
     }
     out[q].reference_keypoint = best_row;
     out[q].distance = static_cast<float>(best);
@@ -63,22 +76,33 @@ template <int kWords>
 
 TOPOSLAM_POPCOUNT_CLONES
 void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
-                       int reference_count, int words, DescriptorMatch* out) {
+                       int reference_count, int words, DescriptorMatch* out, int* reference_best,
+                       int* reference_best_distance) {
   switch (words) {
     case 4:  // ORB, 32 bytes
-      scanBinary<4>(query, query_count, reference, reference_count, words, out);
+      scanBinary<4>(query, query_count, reference, reference_count, words, out, reference_best,
+                    reference_best_distance);
       break;
     case 8:  // BRISK (64 bytes), AKAZE-MLDB (61 bytes, padded)
-      scanBinary<8>(query, query_count, reference, reference_count, words, out);
+      scanBinary<8>(query, query_count, reference, reference_count, words, out, reference_best,
+                    reference_best_distance);
       break;
     default:
-      scanBinary<0>(query, query_count, reference, reference_count, words, out);
+      scanBinary<0>(query, query_count, reference, reference_count, words, out, reference_best,
+                    reference_best_distance);
       break;
   }
 }
 
 void bestFloatMatches(const float* query, int query_count, int query_stride, const float* reference,
-                      int reference_count, int reference_stride, int dims, DescriptorMatch* out) {
+                      int reference_count, int reference_stride, int dims, DescriptorMatch* out,
+                      int* reference_best, float* reference_best_distance) {
+  if (reference_best != nullptr) {
+    for (int r = 0; r < reference_count; ++r) {
+      reference_best[r] = -1;
+      reference_best_distance[r] = std::numeric_limits<float>::infinity();
+    }
+  }
   for (int q = 0; q < query_count; ++q) {
     const float* qrow = query + static_cast<std::ptrdiff_t>(q) * query_stride;
     float best = std::numeric_limits<float>::infinity();
@@ -92,6 +116,10 @@ void bestFloatMatches(const float* query, int query_count, int query_stride, con
         squared += difference * difference;
       }
       consider(squared, r, best, second, best_row);
+      if (reference_best != nullptr && squared < reference_best_distance[r]) {
+        reference_best_distance[r] = squared;
+        reference_best[r] = q;
+      }
     }
     out[q].reference_keypoint = best_row;
     out[q].distance = std::sqrt(best);

@@ -14,11 +14,16 @@ namespace toposlam::detail {
 
 /// For each of query_count query rows (each `words` 64-bit words), the best and second best reference
 /// rows by Hamming distance. out[q].reference_keypoint = -1 when reference_count == 0.
+/// reference_best (optional, with reference_best_distance as scratch, reference_count each) receives the
+/// best query row of every reference row (ties: the earlier query row), for the mutual check, computed
+/// from the same distances.
 void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
-                       int reference_count, int words, DescriptorMatch* out);
+                       int reference_count, int words, DescriptorMatch* out, int* reference_best = nullptr,
+                       int* reference_best_distance = nullptr);
 
 /// Same for float rows of `dims` values (row strides in floats); distances are L2 (not squared).
 void bestFloatMatches(const float* query, int query_count, int query_stride, const float* reference,
-                      int reference_count, int reference_stride, int dims, DescriptorMatch* out);
+                      int reference_count, int reference_stride, int dims, DescriptorMatch* out,
+                      int* reference_best = nullptr, float* reference_best_distance = nullptr);
 
 }  // namespace toposlam::detail

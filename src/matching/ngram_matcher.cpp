@@ -91,6 +91,8 @@ std::string NgramMatcherConfig::validate() const {
   if (!(max_float_distance >= 0.0) || !std::isfinite(max_float_distance))
     return "max_float_distance: must be >= 0 (0 disables the test)";
   if (!(ratio_test > 0.0 && ratio_test <= 1.0)) return "ratio_test: must be in (0, 1] (1 disables the test)";
+  if (!(max_angle_difference_deg >= 0.0 && max_angle_difference_deg <= 180.0))
+    return "max_angle_difference_deg: must be in [0, 180] (0 disables the test)";
   return "";
 }
 
@@ -206,20 +208,26 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
   if (rd.type() != qd.type() || rd.cols != qd.cols) return 0;  // different backends: nothing comparable
 
   resizeFor(s.matches, static_cast<std::size_t>(qd.rows), DescriptorMatch{});
+  const bool mutual = config_.mutual_check;
+  if (mutual) resizeFor(s.reference_best, static_cast<std::size_t>(rd.rows), -1);
   double max_distance = std::numeric_limits<double>::infinity();
   if (rd.depth() == CV_8U) {
     const int words = (rd.cols + 7) / 8;
     packBinaryRows(rd, words, s.reference_words);
     packBinaryRows(qd, words, s.query_words);
+    if (mutual) resizeFor(s.reference_best_bits, static_cast<std::size_t>(rd.rows), 0);
     detail::bestBinaryMatches(s.query_words.data(), qd.rows, s.reference_words.data(), rd.rows, words,
-                              s.matches.data());
+                              s.matches.data(), mutual ? s.reference_best.data() : nullptr,
+                              mutual ? s.reference_best_bits.data() : nullptr);
     if (config_.max_binary_distance_fraction < 1.0) max_distance = config_.max_binary_distance_fraction * 8.0 * rd.cols;
   } else {
     // cv::Mat rows may be padded: pass strides in floats (step is a multiple of 4 for CV_32F).
     const int query_stride = static_cast<int>(qd.step1());
     const int reference_stride = static_cast<int>(rd.step1());
+    if (mutual) resizeFor(s.reference_best_l2, static_cast<std::size_t>(rd.rows), 0.f);
     detail::bestFloatMatches(qd.ptr<float>(0), qd.rows, query_stride, rd.ptr<float>(0), rd.rows,
-                             reference_stride, rd.cols, s.matches.data());
+                             reference_stride, rd.cols, s.matches.data(), mutual ? s.reference_best.data() : nullptr,
+                             mutual ? s.reference_best_l2.data() : nullptr);
     if (config_.max_float_distance > 0.0) max_distance = config_.max_float_distance;
   }
 
@@ -248,6 +256,20 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
     float squared = 0.f;
     for (int c = 0; c < rd.cols; ++c) squared += (a[c] - b[c]) * (a[c] - b[c]);
     return std::sqrt(squared);
+  };
+  // Orientation check (0 = off). Keypoints without an orientation (angle < 0) always pass.
+  const double max_angle = config_.max_angle_difference_deg;
+  const bool check_angles = max_angle > 0.0 && max_angle < 180.0 &&
+                            reference.keypoints.size() == static_cast<std::size_t>(rd.rows) &&
+                            query.keypoints.size() == static_cast<std::size_t>(qd.rows);
+  const auto anglesAgree = [&](int k, int r) {
+    if (!check_angles) return true;
+    const float a = query.keypoints[static_cast<std::size_t>(k)].angle;
+    const float b = reference.keypoints[static_cast<std::size_t>(r)].angle;
+    if (a < 0.f || b < 0.f) return true;
+    double d = std::fabs(static_cast<double>(a) - static_cast<double>(b));
+    d = std::fmod(d, 360.0);
+    return std::min(d, 360.0 - d) <= max_angle;
   };
   // Keeps a match that passed the tests: each reference keypoint counts once per letter pair.
   int kept = 0;
@@ -286,6 +308,8 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
       if (config_.ratio_test < 1.0 &&
           !(static_cast<double>(match.distance) <= config_.ratio_test * match.second_distance))
         continue;
+      if (mutual && s.reference_best[match.reference_keypoint] != k) continue;
+      if (!anglesAgree(k, match.reference_keypoint)) continue;
       keep(match.reference_keypoint, i);
     }
     // Pass 2: equally good candidates resolve to the order-consistent one: in the reference letter this
@@ -317,6 +341,11 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
           chosen_offset_cost = offset_cost;
         }
       }
+      // Mutual check on ties: the chosen reference keypoint's best query keypoint must be as close.
+      if (mutual && (chosen < 0 || s.reference_best[chosen] < 0 ||
+                     distance(s.reference_best[chosen], chosen) != match.distance))
+        continue;
+      if (chosen >= 0 && !anglesAgree(k, chosen)) continue;
       keep(chosen, i);
     }
     previous_partner = partnerOf(i);
@@ -335,6 +364,48 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
   return kept;
 }
 
+void NgramMatcher::verifiedMatchCounts(int m, int q, MatchScratch& s, NgramCounts& result) {
+  const auto cell = [q](int j, int i) { return static_cast<std::size_t>(j) * static_cast<std::size_t>(q) + i; };
+  // Matches per order: a cell counts for order n when some complete diagonal run of n non-empty cells
+  // passes through it.
+  for (int n = 1; n <= kMaxNgramOrder; ++n) {
+    int total = 0;
+    for (int j = 0; j < m; ++j) {
+      for (int i = 0; i < q; ++i) {
+        const int matched = s.pair_matches[cell(j, i)];
+        if (matched <= 0) continue;
+        bool on_ngram = n == 1;
+        for (int start = 0; start < n && !on_ngram; ++start) {  // run covers offsets -start .. n-1-start
+          const int j0 = j - start;
+          const int i0 = i - start;
+          if (j0 < 0 || i0 < 0 || j0 + n > m || i0 + n > q) continue;
+          bool complete = true;
+          for (int t = 0; t < n && complete; ++t) complete = s.pair_matches[cell(j0 + t, i0 + t)] > 0;
+          on_ngram = complete;
+        }
+        if (on_ngram) total += matched;
+      }
+    }
+    result.keypoint_ngram_matches[n - 1] = total;
+  }
+  // Order-preserving alignment: best[j][i] = most matches on a monotone staircase of cells (reference
+  // and query letters both non-decreasing) ending at (j, i). Non-decreasing rather than strictly
+  // increasing, so a letter split in two by an edge seen in only one of the frames keeps both halves.
+  resizeFor(s.alignment, static_cast<std::size_t>(m) * static_cast<std::size_t>(q), 0);
+  int overall = 0;
+  for (int j = 0; j < m; ++j) {
+    for (int i = 0; i < q; ++i) {
+      int previous = 0;
+      if (j > 0) previous = std::max(previous, s.alignment[cell(j - 1, i)]);
+      if (i > 0) previous = std::max(previous, s.alignment[cell(j, i - 1)]);
+      if (j > 0 && i > 0) previous = std::max(previous, s.alignment[cell(j - 1, i - 1)]);
+      s.alignment[cell(j, i)] = previous + s.pair_matches[cell(j, i)];
+      overall = std::max(overall, s.alignment[cell(j, i)]);
+    }
+  }
+  result.aligned_matches = overall;
+}
+
 NgramCounts NgramMatcher::counts(const Fingerprint& reference, const Fingerprint& query,
                                  MatchScratch* scratch) const {
   MatchScratch& s = scratch != nullptr ? *scratch : threadScratch();
@@ -347,6 +418,9 @@ NgramCounts NgramMatcher::counts(const Fingerprint& reference, const Fingerprint
   result.matched_keypoints = matchKeypoints(reference, query, s);
 
   const bool reference_has_keypoints = hasDescriptors(reference);
+  result.reference_keypoints = reference_has_keypoints ? reference.descriptors.rows : 0;
+  result.query_letters = q;
+  if (m > 0 && q > 0 && result.matched_keypoints > 0) verifiedMatchCounts(m, q, s, result);
   for (int n = 1; n <= kMaxNgramOrder; ++n) {
     result.histogram_possible[n - 1] = std::max(0, m - n + 1);
     // Keypoint n-grams are only possible over reference letters that own keypoints.

@@ -85,13 +85,12 @@ Localization PlaceLocalizer::localize(const Fingerprint& query) const {
     histogram_counts[n].assign(k_places, 0.0);
     keypoint_counts[n].assign(k_places, 0.0);
   }
-  const double weight = config_.similarity.histogram_weight;
   for (std::size_t k = 0; k < k_places; ++k) {
     PlaceEvidence& evidence = result.places[k];
     const std::vector<Fingerprint>& references = places_[k].references;
     for (std::size_t r = 0; r < references.size(); ++r) {
       const NgramCounts counts = similarity_.matcher().counts(references[r], query);
-      const double s = NgramSimilarity::fromCounts(counts, weight).similarity;
+      const double s = NgramSimilarity::fromCounts(counts, config_.similarity).similarity;
       if (evidence.best_reference < 0 || s > evidence.similarity) {
         evidence.best_reference = static_cast<int>(r);
         evidence.similarity = s;

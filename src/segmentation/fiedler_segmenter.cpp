@@ -65,6 +65,15 @@ std::string FiedlerSegmenterConfig::validate() const {
   if (window < 3 || window > 1000) {
     return "window: " + std::to_string(window) + " frames is outside the allowed range [3, 1000]";
   }
+  if (!(window_s >= 0.0 && window_s <= 3600.0)) {
+    std::ostringstream message;
+    message << "window_s: " << window_s << " s is outside the allowed range [0, 3600] (0 = count frames)";
+    return message.str();
+  }
+  if (min_window_frames < 3 || min_window_frames > window) {
+    return "min_window_frames: " + std::to_string(min_window_frames) + " is outside the allowed range [3, window = " +
+           std::to_string(window) + "]";
+  }
   if (std::string problem = valley.validate(maxFiedlerValue(window)); !problem.empty()) return problem;
   if (!(similarity_floor >= 0.0 && similarity_floor < 1.0)) {
     std::ostringstream message;
@@ -120,22 +129,38 @@ FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const S
 }
 
 int FiedlerSegmenter::slotAtPosition(int position) const {
-  const int oldest = count_ == config_.window ? next_slot_ : 0;
-  return (oldest + position) % config_.window;
+  const int n = config_.window;
+  return ((next_slot_ - count_ + position) % n + n) % n;
 }
 
 double FiedlerSegmenter::computeLambda2() {
   const int k = count_;
-  if (k == config_.window) {
-    // Steady state: the full preallocated matrices, no allocation.
+  const int n = config_.window;
+  if (k == n) {
+    // Every slot is in the window (order does not matter for eigenvalues): the full matrices.
     buildSymmetricLaplacian(affinity_, degree_, inv_sqrt_degree_, laplacian_);
     solver_.compute(laplacian_, Eigen::EigenvaluesOnly);
-  } else {
-    // Filling up: slots 0..k-1 are the occupied ones.
-    buildSymmetricLaplacian(affinity_.topLeftCorner(k, k), degree_.head(k), inv_sqrt_degree_.head(k),
-                            laplacian_.topLeftCorner(k, k));
-    solver_.compute(laplacian_.topLeftCorner(k, k), Eigen::EigenvaluesOnly);
+    return std::max(0.0, solver_.eigenvalues()(1));
   }
+  // Degrees per slot (other code reads degree_ by slot), then L_sym in window order in the top-left
+  // k x k of the scratch matrix. Eigenvalues do not depend on the order. At a steady frame rate k is
+  // constant, so the solver's storage is reused and nothing is allocated.
+  for (int a = 0; a < k; ++a) {
+    const int sa = slotAtPosition(a);
+    double d = 0.0;
+    for (int b = 0; b < k; ++b) d += affinity_(sa, slotAtPosition(b));
+    degree_(sa) = d;
+    inv_sqrt_degree_(sa) = d > 0.0 ? 1.0 / std::sqrt(d) : 0.0;
+  }
+  for (int b = 0; b < k; ++b) {
+    const int sb = slotAtPosition(b);
+    for (int a = 0; a < k; ++a) {
+      const int sa = slotAtPosition(a);
+      laplacian_(a, b) = -inv_sqrt_degree_(sa) * affinity_(sa, sb) * inv_sqrt_degree_(sb);
+    }
+    laplacian_(b, b) = degree_(sb) > 0.0 ? 1.0 : 0.0;
+  }
+  solver_.compute(laplacian_.topLeftCorner(k, k), Eigen::EigenvaluesOnly);
   // L_sym is positive semi-definite; clamp round-off below zero.
   return std::max(0.0, solver_.eigenvalues()(1));
 }
@@ -236,27 +261,41 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
   }
 
   const int n = config_.window;
+  // The ring is full: the oldest frame leaves to make room.
+  if (count_ == n) {
+    --count_;
+    window_full_ = true;
+  }
+  // A window in time: frames taken window_s or more before this one leave (keeping min_window_frames).
+  // A clock that goes back (a new traversal) leaves them all in: only the ring's size then evicts.
+  if (config_.window_s > 0.0) {
+    const double tolerance = 1e-6 * config_.window_s;
+    while (count_ >= config_.min_window_frames) {
+      const double oldest_time = slot_time_[static_cast<std::size_t>(slotAtPosition(0))];
+      if (!(time_s - oldest_time >= config_.window_s - tolerance)) break;
+      --count_;
+      window_full_ = true;
+    }
+  }
   const int slot = next_slot_;
   const auto s = static_cast<std::size_t>(slot);
   slot_fingerprint_[s] = std::move(fingerprint);
   slot_frame_[s] = frame_index;
   slot_time_[s] = time_s;
-  const int occupied_before = count_;
-  // Only the new frame's row and column are new: 2 (k-1) similarity calls.
+  // Only the new frame's row and column are new: 2 (k-1) similarity calls. Slots outside the window
+  // are never read, so their rows are not cleared.
   affinity_(slot, slot) = 0.0;
-  for (int other = 0; other < n; ++other) {
-    if (other == slot) continue;
-    double value = 0.0;
-    if (occupied_before == n || other < occupied_before) {
-      value = sanitizeSimilarity(similarity_.symmetricSimilarity(
-          *slot_fingerprint_[static_cast<std::size_t>(other)], *slot_fingerprint_[s]));
-      value = std::max(0.0, value - config_.similarity_floor);
-    }
+  for (int position = 0; position < count_; ++position) {
+    const int other = slotAtPosition(position);
+    double value = sanitizeSimilarity(
+        similarity_.symmetricSimilarity(*slot_fingerprint_[static_cast<std::size_t>(other)], *slot_fingerprint_[s]));
+    value = std::max(0.0, value - config_.similarity_floor);
     affinity_(slot, other) = value;
     affinity_(other, slot) = value;
   }
-  count_ = std::min(count_ + 1, n);
+  ++count_;
   next_slot_ = (slot + 1) % n;
+  if (config_.window_s <= 0.0 && count_ == n) window_full_ = true;
   last_frame_ = frame_index;
   last_time_s_ = time_s;
   if (place_start_ < 0) {
@@ -275,7 +314,7 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
 
   // The detector sees lambda2 only once the window is full: while it fills, lambda2 of a perfectly
   // connected window falls as k/(k-1) (2, 1.5, 1.33, ...), which would read as a peak.
-  if (count_ == n && step.lambda2) {
+  if (window_full_ && step.lambda2) {
     const std::optional<std::int64_t> valley = detector_.update(frame_index, *step.lambda2);
     if (!detector_.lookingForPeak() && detector_.minIndex() == frame_index) {
       // A new minimum: remember where its border would be and a candidate before that border.

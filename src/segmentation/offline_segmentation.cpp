@@ -14,6 +14,14 @@ std::string formatNumber(double value, int decimals) {
   return buffer;
 }
 
+// A CSV field, quoted (quotes doubled) when it holds a comma, a quote or a line break.
+std::string csvField(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
 std::int64_t nodeOf(const std::vector<std::int64_t>& place_nodes, std::int64_t place) {
   if (place < 0 || place >= static_cast<std::int64_t>(place_nodes.size())) return -1;
   return place_nodes[static_cast<std::size_t>(place)];
@@ -64,12 +72,20 @@ void OfflineSegmentation::record(const SegmentedPlace& place) {
 }
 
 void writeFramesCsv(std::ostream& out, const SegmentationRun& run,
-                    const std::vector<std::int64_t>& place_nodes) {
-  out << "frame,time,name,lambda2,place,node\n";
+                    const std::vector<std::int64_t>& place_nodes, const FrameLoopColumns* loop) {
+  out << "frame,time,name,lambda2,place,node" << (loop != nullptr ? ",node_probability,match,match_score" : "") << "\n";
   for (const SegmentationFrameRecord& row : run.frames) {
-    out << row.frame << ',' << formatNumber(row.time_s, 6) << ',' << row.name << ','
+    out << row.frame << ',' << formatNumber(row.time_s, 6) << ',' << csvField(row.name) << ','
         << (row.lambda2 ? formatNumber(*row.lambda2, 6) : std::string()) << ',' << row.place << ','
-        << nodeOf(place_nodes, row.place) << '\n';
+        << nodeOf(place_nodes, row.place);
+    if (loop != nullptr) {
+      const auto f = static_cast<std::size_t>(row.frame);
+      const bool placed = row.place >= 0 && static_cast<std::size_t>(row.place) < loop->place_probability.size();
+      out << ',' << (placed ? formatNumber(loop->place_probability[static_cast<std::size_t>(row.place)], 6) : std::string())
+          << ',' << (f < loop->match_frame.size() ? loop->match_frame[f] : -1) << ','
+          << (f < loop->match_score.size() && loop->match_frame[f] >= 0 ? formatNumber(loop->match_score[f], 6) : std::string());
+    }
+    out << '\n';
   }
 }
 

@@ -118,7 +118,35 @@ std::string TopologyFilterConfig::validate() const {
   if (max_representatives_per_node < 1 || max_representatives_per_node > kTopologyMaxRepresentatives) {
     return "max_representatives_per_node: must be in [1, 16]";
   }
+  if (likelihood != LikelihoodModel::Absolute && likelihood != LikelihoodModel::Relative)
+    return "likelihood: must be absolute or relative";
+  if (!(relative_slope > 0.0 && relative_slope <= 100.0)) return "relative_slope: must be in (0, 100]";
+  if (!(relative_offset >= -10.0 && relative_offset <= 10.0)) return "relative_offset: must be in [-10, 10]";
+  if (!(relative_sigma_floor > 0.0 && relative_sigma_floor <= 1.0))
+    return "relative_sigma_floor: must be in (0, 1]";
   return "";
+}
+
+const char* toString(LikelihoodModel model) {
+  return model == LikelihoodModel::Relative ? "relative" : "absolute";
+}
+
+LikelihoodModel parseLikelihoodModel(const std::string& name) {
+  if (name == "absolute") return LikelihoodModel::Absolute;
+  if (name == "relative") return LikelihoodModel::Relative;
+  throw std::invalid_argument("likelihood model '" + name + "': expected absolute or relative");
+}
+
+double relativeLikelihood(double similarity, double others_sum, double others_sum_sq, int others_count,
+                          double slope, double offset, double sigma_floor) {
+  double z = 0.0;
+  if (others_count > 0) {
+    const double n = static_cast<double>(others_count);
+    const double mean = others_sum / n;
+    const double variance = std::max(0.0, others_sum_sq / n - mean * mean);
+    z = (similarity - mean) / std::max(std::sqrt(variance), sigma_floor);
+  }
+  return 1.0 / (1.0 + std::exp(-slope * (z - offset)));
 }
 
 double gammaPdf(double x, double shape, double scale) {
@@ -170,6 +198,23 @@ TopologyParticleFilter::~TopologyParticleFilter() = default;
 double TopologyParticleFilter::uniform01() {
   // 53 random bits -> [0, 1), identical on every platform (std distributions are not specified).
   return static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+}
+
+void TopologyParticleFilter::relativeLikelihoods() {
+  // Leave-one-out: each stored representative against the others this step compares with. Sums in
+  // observation order, so the result does not depend on how the step was sliced.
+  double sum = 0.0, sum_sq = 0.0;
+  for (const std::int32_t o : needed_list_) {
+    const double s = similarity_of_[idx(o)];
+    sum += s;
+    sum_sq += s * s;
+  }
+  const int others = static_cast<int>(needed_list_.size()) - 1;
+  for (const std::int32_t o : needed_list_) {
+    double& s = similarity_of_[idx(o)];
+    s = relativeLikelihood(s, sum - s, sum_sq - s * s, others, config_.relative_slope, config_.relative_offset,
+                           config_.relative_sigma_floor);
+  }
 }
 
 void TopologyParticleFilter::beginStep(std::shared_ptr<const Fingerprint> representative) {
@@ -230,6 +275,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           const double s = similarity_.similarity(*fingerprints_[o], *pending_);
           similarity_of_[o] = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
         }
+        if (config_.likelihood == LikelihoodModel::Relative) relativeLikelihoods();
         phase_ = Phase::Aggregate;
         cursor_ = 0;
         break;
@@ -515,6 +561,11 @@ void TopologyParticleFilter::saveState(std::ostream& out) const {
   }
   w.u32(static_cast<std::uint32_t>(particles_.size()));
   for (const auto& p : particles_) w.i32(p->record ? id.at(p->record.get()) : -1);
+  // Extension block (absent in maps written before the likelihood model existed: those are absolute).
+  w.u8(static_cast<std::uint8_t>(config_.likelihood));
+  w.f64(config_.relative_slope);
+  w.f64(config_.relative_offset);
+  w.f64(config_.relative_sigma_floor);
   const std::string& data = w.data();
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
 }
@@ -616,7 +667,21 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     if (!ok) throw std::runtime_error("map data has a particle pointing at a bad history record");
     if (t >= 0) is_tip[idx(t)] = 1;
   }
+  if (!r.atEnd()) {
+    const std::uint8_t model = r.u8("likelihood model");
+    if (model > static_cast<std::uint8_t>(LikelihoodModel::Relative))
+      throw std::runtime_error("map data: unknown likelihood model " + std::to_string(model));
+    config.likelihood = static_cast<LikelihoodModel>(model);
+    config.relative_slope = r.f64("likelihood model");
+    config.relative_offset = r.f64("likelihood model");
+    config.relative_sigma_floor = r.f64("likelihood model");
+    if (const std::string problem = config.validate(); !problem.empty())
+      throw std::runtime_error("map data: bad filter config: " + problem);
+  } else {
+    config.likelihood = LikelihoodModel::Absolute;  // written before the likelihood model existed
+  }
   if (!r.atEnd()) throw std::runtime_error("map data has trailing bytes after the particles");
+  filter->config_ = config;  // the likelihood model came after the filter was made
 
   // Rebuild the shared states by replaying the record tree (extendState is what the filter ran).
   std::vector<std::shared_ptr<const TopologyState>> states(record_count);

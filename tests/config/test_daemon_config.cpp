@@ -68,6 +68,18 @@ SCENARIO("The shipped config documents the defaults in code") {
       CHECK(shipped.similarity.matcher.ratio_test == defaults.similarity.matcher.ratio_test);
       CHECK(shipped.similarity.histogram_weight == defaults.similarity.histogram_weight);
       CHECK(shipped.segmentation.window == defaults.segmentation.window);
+      CHECK(shipped.segmentation.window_s == defaults.segmentation.window_s);
+      CHECK(shipped.segmentation.min_window_frames == defaults.segmentation.min_window_frames);
+      CHECK(shipped.preset == defaults.preset);
+      CHECK(shipped.similarity.matcher.mutual_check == defaults.similarity.matcher.mutual_check);
+      CHECK(shipped.similarity.matcher.max_angle_difference_deg == defaults.similarity.matcher.max_angle_difference_deg);
+      CHECK(shipped.similarity.histogram_gate == defaults.similarity.histogram_gate);
+      CHECK(shipped.similarity.histogram_only_fallback == defaults.similarity.histogram_only_fallback);
+      CHECK(shipped.similarity.keypoint_scoring == defaults.similarity.keypoint_scoring);
+      CHECK(shipped.topology.likelihood == defaults.topology.likelihood);
+      CHECK(shipped.topology.relative_slope == defaults.topology.relative_slope);
+      CHECK(shipped.topology.relative_offset == defaults.topology.relative_offset);
+      CHECK(shipped.topology.relative_sigma_floor == defaults.topology.relative_sigma_floor);
       CHECK(shipped.segmentation.valley.gamma == defaults.segmentation.valley.gamma);
       CHECK(shipped.segmentation.valley.delta == defaults.segmentation.valley.delta);
       CHECK(shipped.segmentation.min_keypoints == defaults.segmentation.min_keypoints);
@@ -207,4 +219,23 @@ SCENARIO("DaemonConfig::validate() names keys by their YAML path") {
   c = DaemonConfig{};
   c.source.clear();
   CHECK_THAT(c.validate(), Catch::StartsWith("source: must not be empty"));
+}
+
+SCENARIO("GIVEN preset: thesis WHEN the config is read THEN every stage takes the published method and later keys override it") {
+  const DaemonConfig c = parseDaemonConfig("preset: thesis\nsegmentation: {window: 40}\n");
+  CHECK(c.preset == "thesis");
+  CHECK(c.similarity.histogram_weight == 0.5);
+  CHECK(c.similarity.keypoint_scoring == KeypointScoring::PossibleNgrams);
+  CHECK_FALSE(c.similarity.matcher.mutual_check);
+  CHECK(c.fingerprint.keypoints.orb_levels == 4);
+  CHECK(c.segmentation.window_s == 0.0);
+  CHECK(c.segmentation.window == 40);  // the key after the preset wins
+  CHECK(c.segmentation.valley.delta == 0.25);
+  CHECK(c.segmentation.cut_placement == CutPlacement::ValleyFrame);
+  CHECK(c.topology.likelihood == LikelihoodModel::Absolute);
+  const DaemonConfig d = parseDaemonConfig("source: \"sim:office\"\n");
+  CHECK(d.preset == "default");
+  CHECK(d.topology.likelihood == LikelihoodModel::Relative);
+  CHECK(d.segmentation.window_s == 6.0);
+  CHECK_THROWS_WITH(parseDaemonConfig("preset: fancy\n"), Catch::Contains("preset") && Catch::Contains("thesis"));
 }

@@ -292,9 +292,12 @@ SCENARIO("toposlamd maps the simulated two-traversal office and publishes it ove
       }
       INFO("second traversal: " << second_places.size() << " places in rooms seen before, " << closed
                                 << " on a first-traversal node of their room, " << wrong << " on another room's node");
-      REQUIRE(second_places.size() >= 6);  // measured: 7 (the others have their representative in a doorway)
-      CHECK(closed >= static_cast<int>(second_places.size()) - 1);
-      CHECK(wrong == 0);
+      // Measured with the default preset (docs/topology.md, "The simulated office"): 16 places in rooms seen
+      // before, 9 closed, 1 on another room's node (a place that straddles a doorway). The thesis-era
+      // defaults closed 15 of 16 here but no loop at all on real frames.
+      REQUIRE(second_places.size() >= 6);
+      CHECK(closed >= static_cast<int>(second_places.size()) / 2);
+      CHECK(wrong <= 1);
     }
   }
 }

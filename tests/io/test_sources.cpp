@@ -145,7 +145,8 @@ TEST_CASE("GIVEN bad URIs WHEN opened THEN the errors name the problem and what 
   CHECK_THAT(openError("sim:castle"), Catch::Contains("castle") && Catch::Contains("office"));
   CHECK_THAT(openError("sim:"), Catch::Contains("world"));
   CHECK_THAT(openError("images:/nonexistent/folder"), Catch::Contains("/nonexistent/folder"));
-  CHECK_THAT(openError("images:" + kSamples + "?fps=3"), Catch::Contains("fps"));
+  CHECK_THAT(openError("images:" + kSamples + "?fps=0"), Catch::Contains("fps=0"));
+  CHECK_THAT(openError("images:" + kSamples + "?speed=3"), Catch::Contains("speed"));
   CHECK_THAT(openError("images:" + kSamples + "?rate=0"), Catch::Contains("rate=0"));
   CHECK_THAT(openError("video:/nonexistent.mp4"), Catch::Contains("/nonexistent.mp4"));
   CHECK_THAT(openError("/nonexistent/thing"), Catch::Contains("/nonexistent/thing") && Catch::Contains("images:"));

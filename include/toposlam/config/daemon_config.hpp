@@ -34,6 +34,9 @@ struct LcmSettings {
 };
 
 struct DaemonConfig {
+  /// Method preset (method_preset.hpp): "default" (measured on real frames) or "thesis"; it sets every
+  /// stage's settings before the other keys are read.
+  std::string preset = "default";
   /// Frame source URI (see io/source_factory.hpp): images:PATH, video:FILE, sim:WORLD?..., v4l2:/dev/videoN.
   std::string source = "sim:office?route=loop2";
   LcmSettings lcm;

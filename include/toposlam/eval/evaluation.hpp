@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "toposlam/eval/metrics.hpp"
+#include "toposlam/eval/recognition.hpp"
 #include "toposlam/eval/run_files.hpp"
 
 namespace toposlam::eval {
@@ -27,6 +28,7 @@ struct RunData {
   std::vector<PlaceRecord> dropped_places;  ///< dropped_places.csv, empty when absent
   std::optional<TopologyFile> topology;     ///< topology.json (from `map`)
   std::vector<TimingRow> timing;            ///< timing.csv
+  bool has_frame_matches = false;           ///< frames.csv has the match columns of `map`
   /// First frame of each traversal: frame 0, then every frame whose time is below the previous frame's
   /// (a new source of `map`), unless set explicitly (evenly split, see splitTraversals).
   std::vector<std::int64_t> traversal_starts;
@@ -79,6 +81,8 @@ struct EvalResult {
   int min_gap = 0;
   std::optional<std::vector<LocalisationRow>> localisation;  ///< needs labels and a node per frame
   std::optional<PrCurve> loop_closure;                       ///< needs nodes (from `map`)
+  /// Frame-level loop closures (each frame's detected earlier frame); needs frames.csv's match column.
+  std::optional<RecognitionScore> frame_loop_closure;
   std::optional<BoundaryScore> boundaries;                   ///< needs labels
   std::optional<std::vector<TraversalCount>> places_per_traversal;
   std::optional<ConsistencyScore> consistency;

@@ -39,6 +39,9 @@ struct FrameRecord {
   double lambda2 = std::numeric_limits<double>::quiet_NaN();  ///< NaN when empty
   int place = -1;
   int node = -1;
+  double node_probability = std::numeric_limits<double>::quiet_NaN();  ///< NaN when absent
+  std::int64_t match = -1;  ///< frame-level loop-closure detection (earlier frame), -1: none
+  double match_score = 0.0;
 };
 
 /// One row of places.csv / dropped_places.csv.

@@ -30,7 +30,8 @@ bool imageBytesLookComplete(const std::vector<unsigned char>& bytes);
 class ImageFilesSource : public FrameSource {
  public:
   /// timestamps are file index / timestamp_rate_hz (the bundled samples are ~1 Hz keyframes).
-  ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0);
+  /// rate_given = false: the rate is an assumption, and describe() says so.
+  ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0, bool rate_given = true);
   std::string describe() const override;
   std::optional<Frame> next() override;
   void interrupt() override { interrupted_.store(true); }
@@ -42,6 +43,7 @@ class ImageFilesSource : public FrameSource {
   std::string origin_;
   std::vector<std::string> files_;
   double rate_hz_;
+  bool rate_given_ = true;
   std::size_t next_index_ = 0;
   std::int64_t skipped_ = 0;
   std::atomic<bool> interrupted_{false};

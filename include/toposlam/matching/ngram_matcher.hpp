@@ -46,6 +46,13 @@ struct NgramMatcherConfig {
   /// Lowe's ratio test: kept when best <= ratio * second best among the reference's keypoints.
   /// 1 disables it. Default 0.9 (measured on the samples, docs/matching.md).
   double ratio_test = 0.9;
+  /// Mutual check: a match is kept only when the query keypoint is also the reference keypoint's best
+  /// match among the query's keypoints (thesis: no; measured on real frames, docs/matching.md).
+  bool mutual_check = false;
+  /// Orientation check: a match is kept only when the two keypoints' orientations differ by at most
+  /// this many degrees (an upright camera sees a revisited point at nearly its old orientation; random
+  /// matches are spread over all 360). 0 disables it (thesis: no).
+  double max_angle_difference_deg = 0.0;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
   std::string validate() const;
 };
@@ -63,7 +70,15 @@ struct NgramCounts {
   std::array<int, kMaxNgramOrder> histogram_possible{};
   std::array<int, kMaxNgramOrder> keypoint_possible{};
   int query_keypoints = 0;
+  int reference_keypoints = 0;
+  int query_letters = 0;  ///< subregions of the query
   int matched_keypoints = 0;  ///< query keypoints whose best match passed the tests
+  /// Verified matches (distinct reference keypoints per letter pair) that lie in a letter pair belonging
+  /// to at least one complete keypoint n-gram of order n: [0] all of them, [1] those on a bigram, ...
+  std::array<int, kMaxNgramOrder> keypoint_ngram_matches{};
+  /// The most verified matches on one order-preserving alignment of letters (reference letters and
+  /// query letters both increasing): the n-gram order check without requiring consecutive letters.
+  int aligned_matches = 0;
 };
 
 /// One corresponding letter pair with its score (for explanations, drawings and tests; not hot).
@@ -100,6 +115,10 @@ struct MatchScratch {
   std::vector<int> last_query_letter;  ///< per reference keypoint: last query letter that matched it
   std::vector<int> pair_matches;       ///< reference letters x query letters, distinct matched keypoints
   std::vector<DescriptorMatch> matches;  ///< per query keypoint
+  std::vector<int> reference_best;       ///< per reference keypoint: its best query keypoint (mutual check)
+  std::vector<int> reference_best_bits;  ///< scratch of the binary kernel
+  std::vector<float> reference_best_l2;  ///< scratch of the float kernel
+  std::vector<int> alignment;            ///< reference letters x query letters, alignment DP
 };
 
 class NgramMatcher {
@@ -134,6 +153,8 @@ class NgramMatcher {
   void matchHistograms(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s) const;
   /// Returns the number of query keypoints whose match was kept.
   int matchKeypoints(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s) const;
+  /// Fills keypoint_ngram_matches and aligned_matches from s.pair_matches (m x q).
+  static void verifiedMatchCounts(int m, int q, MatchScratch& s, NgramCounts& result);
 
   NgramMatcherConfig config_;
 };

@@ -13,6 +13,7 @@
 // Thread-safety: const and re-entrant; the hot path allocates nothing (per-thread scratch).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "toposlam/matching/ngram_matcher.hpp"
@@ -20,10 +21,31 @@
 
 namespace toposlam {
 
+/// How the keypoint part S_kp is made from the n-gram counts.
+enum class KeypointScoring : std::uint8_t {
+  /// Thesis: mean over n of effective keypoint n-grams / possible n-grams of the reference.
+  PossibleNgrams = 0,
+  /// Real images (docs/matching.md): the verified keypoint matches that keep the subregion order (the
+  /// most on one order-preserving alignment of letters, NgramCounts::aligned_matches) over
+  /// min(reference keypoints, query keypoints). Frames with 1-2 letters score like any other.
+  VerifiedMatches = 1,
+};
+const char* toString(KeypointScoring scoring);
+/// Parses "possible-ngrams" or "verified-matches"; throws std::invalid_argument otherwise.
+KeypointScoring parseKeypointScoring(const std::string& name);
+
 struct NgramSimilarityConfig {
   NgramMatcherConfig matcher;
   /// Weight of the histogram part; the keypoint part gets 1 - this (default: plain mean of both).
   double histogram_weight = 0.5;
+  KeypointScoring keypoint_scoring = KeypointScoring::PossibleNgrams;
+  /// Histograms as a gate rather than a summand: similarity = S_kp x (1 - w + w S_hist), w =
+  /// histogram_weight, so keypoint evidence between differently coloured places is scaled down and
+  /// colour alone never makes a match (docs/matching.md). Off: the weighted sum (thesis).
+  bool histogram_gate = false;
+  /// A reference without keypoints is scored by its histograms alone (thesis reading). Off, its
+  /// keypoint part is 0: a blank wall is no evidence of a place.
+  bool histogram_only_fallback = true;
   std::string validate() const;
 };
 
@@ -47,7 +69,7 @@ class NgramSimilarity : public SimilarityMeasure {
   SimilarityBreakdown explain(const Fingerprint& reference, const Fingerprint& query) const;
 
   /// The normalisation above applied to counts computed elsewhere (e.g. by PlaceLocalizer).
-  static SimilarityBreakdown fromCounts(const NgramCounts& counts, double histogram_weight);
+  static SimilarityBreakdown fromCounts(const NgramCounts& counts, const NgramSimilarityConfig& config);
 
   const NgramMatcher& matcher() const { return matcher_; }
   const NgramSimilarityConfig& config() const { return config_; }

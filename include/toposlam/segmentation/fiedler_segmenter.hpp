@@ -61,9 +61,16 @@ const char* toString(CutPlacement placement);
 CutPlacement parseCutPlacement(const std::string& name);
 
 struct FiedlerSegmenterConfig {
-  /// Frames in the sliding window; allowed [3, 1000]. Thesis: 25 (at ~5 fps). Our default, 30 with
-  /// delta 0.30, was chosen by measurement on the simulated routes (docs/segmentation.md, "Defaults").
+  /// The sliding window in time, seconds (docs/segmentation.md, "A window in time"): the window holds
+  /// the frames taken less than window_s before the newest one, from the frames' own timestamps, so
+  /// the places found do not depend on the frame rate. Allowed [0, 3600]; 0 = count frames instead
+  /// (exactly `window` frames). Thesis: 25 frames at ~5 fps, i.e. 5 s.
+  double window_s = 0.0;
+  /// With window_s = 0: frames in the window, allowed [3, 1000]; thesis 25, ours 30 with delta 0.30
+  /// (docs/segmentation.md, "Defaults"). With window_s > 0: the most frames the window may hold.
   int window = 30;
+  /// With window_s > 0: the fewest frames the window keeps however long they took; allowed [3, window].
+  int min_window_frames = 5;
   /// Subtracted from every similarity before it enters the affinity matrix (clamped at 0), so frames
   /// of different places, which still match ~0.15 by colour, become unlinked. Allowed [0, 1).
   double similarity_floor = 0.0;
@@ -123,6 +130,9 @@ class FiedlerSegmenter {
   const FiedlerSegmenterConfig& config() const { return config_; }
   /// Frames currently in the window (<= config().window).
   int windowFrames() const { return count_; }
+  /// True once the window spans its full length (window_s, or `window` frames): lambda2 goes to the
+  /// valley detector only from then on.
+  bool windowFull() const { return window_full_; }
   /// First frame of the open place, or -1 before any frame.
   std::int64_t openPlaceStart() const { return place_start_; }
   /// Valleys that could not close a place (their best split fell before the open place started).
@@ -157,8 +167,10 @@ class FiedlerSegmenter {
   const SimilarityMeasure& similarity_;
   ValleyDetector detector_;
 
-  // Ring window: slot s holds frame slot_frame_[s]; next_slot_ is where the next frame goes.
+  // Ring window: slot s holds frame slot_frame_[s]; next_slot_ is where the next frame goes; the window
+  // is the count_ slots before it (oldest first), so evicting the oldest frame is --count_.
   int count_ = 0;
+  bool window_full_ = false;
   int next_slot_ = 0;
   std::vector<std::shared_ptr<const Fingerprint>> slot_fingerprint_;
   std::vector<std::int64_t> slot_frame_;
@@ -166,7 +178,7 @@ class FiedlerSegmenter {
   Eigen::MatrixXd affinity_;  ///< n x n, symmetric, zero diagonal; rows of empty slots are 0
   Eigen::VectorXd degree_;    ///< n
   Eigen::VectorXd inv_sqrt_degree_;
-  Eigen::MatrixXd laplacian_;  ///< n x n scratch
+  Eigen::MatrixXd laplacian_;  ///< n x n scratch, window order (top-left count_ x count_)
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver_;
 
   std::int64_t last_frame_ = -1;

@@ -71,10 +71,19 @@ class OfflineSegmentation {
   SegmentationRun run_;
 };
 
-/// frames.csv: `frame,time,name,lambda2,place,node`. `place_nodes[p]` is the node of kept place p
-/// (missing or no vector: -1).
+/// Per-frame results of the filter for frames.csv (`map`): each kept place's node probability and each
+/// frame's loop-closure detection (docs/run-folder.md).
+struct FrameLoopColumns {
+  std::vector<double> place_probability;  ///< by kept place
+  std::vector<std::int64_t> match_frame;  ///< by frame, -1: no detection
+  std::vector<double> match_score;        ///< by frame
+};
+
+/// frames.csv: `frame,time,name,lambda2,place,node` (+ `node_probability,match,match_score` with
+/// `loop`). `place_nodes[p]` is the node of kept place p (missing or no vector: -1). Names are quoted
+/// as CSV fields when they hold a comma, a quote or a line break.
 void writeFramesCsv(std::ostream& out, const SegmentationRun& run,
-                    const std::vector<std::int64_t>& place_nodes = {});
+                    const std::vector<std::int64_t>& place_nodes = {}, const FrameLoopColumns* loop = nullptr);
 /// places.csv / dropped_places.csv: `place,first,last,representative,keypoints,node`.
 void writePlacesCsv(std::ostream& out, const std::vector<SegmentedPlace>& places,
                     const std::vector<std::int64_t>& place_nodes = {});

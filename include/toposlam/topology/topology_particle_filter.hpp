@@ -55,6 +55,23 @@ class TrieNode;
 inline constexpr int kTopologyMaxSuccessors = 8;
 inline constexpr int kTopologyMaxRepresentatives = 16;
 
+/// How a stored representative's similarity with the new one becomes its appearance likelihood.
+enum class LikelihoodModel : std::uint8_t {
+  /// Thesis (eq. 5.5): the similarity itself.
+  Absolute = 0,
+  /// Per query, relative to the other stored representatives (docs/topology.md): z = (s - mean of the
+  /// others) / max(std of the others, sigma_floor), likelihood = logistic(slope (z - offset)).
+  Relative = 1,
+};
+const char* toString(LikelihoodModel model);
+/// Parses "absolute" or "relative"; throws std::invalid_argument otherwise.
+LikelihoodModel parseLikelihoodModel(const std::string& name);
+
+/// The relative likelihood of one similarity among `others_count` others with sums `others_sum` and
+/// `others_sum_sq` (leave-one-out statistics; others_count 0 gives z = 0).
+double relativeLikelihood(double similarity, double others_sum, double others_sum_sq, int others_count,
+                          double slope, double offset, double sigma_floor);
+
 struct TopologyFilterConfig {
   int particles = 500;                   ///< M (thesis: 500); allowed [1, 1000000]
   double alpha = 15.0;                   ///< prior map size of eq. 5.8 (thesis: 15); allowed (0, 1e6]
@@ -68,6 +85,10 @@ struct TopologyFilterConfig {
   /// preceded the current one anyway, and one that also followed it earlier is a forward move (see docs).
   bool forbid_return_to_previous = false;
   std::uint64_t seed = 1;  ///< of the filter's std::mt19937_64
+  LikelihoodModel likelihood = LikelihoodModel::Absolute;
+  double relative_slope = 3.0;         ///< logistic slope per z unit; allowed (0, 100]
+  double relative_offset = 2.5;        ///< z at which the likelihood is 1/2; allowed [-10, 10]
+  double relative_sigma_floor = 0.02;  ///< smallest spread of the others' similarities; allowed (0, 1]
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
   std::string validate() const;
 };
@@ -172,6 +193,8 @@ class TopologyParticleFilter {
 
   double uniform01();
   void finishStep();
+  /// LikelihoodModel::Relative: turns this step's similarities into relative likelihoods, in place.
+  void relativeLikelihoods();
 
   TopologyFilterConfig config_;
   const SimilarityMeasure& similarity_;

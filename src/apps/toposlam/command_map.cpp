@@ -36,6 +36,7 @@
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/topology/map_store.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
@@ -55,6 +56,17 @@ struct MapOptions {
   std::string resume;
   std::string keypoints = "orb";
   SegmentationOptions segmentation;
+  int loop_min_gap = 10;  ///< frame-level loop closures: detections at least this many frames back
+  std::string likelihood = toString(methodPreset("default").topology.likelihood);
+  double relative_slope = methodPreset("default").topology.relative_slope;
+  double relative_offset = methodPreset("default").topology.relative_offset;
+  double relative_sigma_floor = methodPreset("default").topology.relative_sigma_floor;
+  double histogram_weight = -1.0;  ///< -1: the preset's
+  int histogram_gate = -1;         ///< -1: the preset's
+  CLI::Option* likelihood_given = nullptr;
+  CLI::Option* slope_given = nullptr;
+  CLI::Option* offset_given = nullptr;
+  CLI::Option* floor_given = nullptr;
 };
 
 /// Per observation of the map (this run's and earlier runs'): where it came from.
@@ -88,6 +100,15 @@ double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The last path component of a source URI's path ("images:/d/corridor/ref?fps=1" -> "ref").
+std::string sourceLabel(const std::string& uri) {
+  std::string path = uri.substr(uri.find(':') == std::string::npos ? 0 : uri.find(':') + 1);
+  if (const auto q = path.find('?'); q != std::string::npos) path = path.substr(0, q);
+  while (path.size() > 1 && path.back() == '/') path.pop_back();
+  const std::string label = fs::path(path).filename().string();
+  return label.empty() ? "source" : label;
+}
+
 std::string shellQuote(const std::string& text) {
   std::string out = "'";
   for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -100,10 +121,14 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const fs::path out_dir(o.out);
   createRunFolder(o.out);
 
-  VpackConfig vpack;
+  const MethodPreset preset = presetOf(o.segmentation, "map");
+  VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   const VpackExtractor extractor(vpack);
-  const NgramSimilarity similarity;
+  NgramSimilarityConfig similarity_config = preset.similarity;
+  if (o.histogram_weight >= 0) similarity_config.histogram_weight = o.histogram_weight;
+  if (o.histogram_gate >= 0) similarity_config.histogram_gate = o.histogram_gate == 1;
+  const NgramSimilarity similarity(similarity_config);
 
   std::unique_ptr<TopologyParticleFilter> filter;
   std::vector<ObservationOrigin> origins;
@@ -120,11 +145,15 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
     std::cerr << "map: resumed " << o.resume << " (" << filter->observationCount() << " places)\n";
   } else {
-    TopologyFilterConfig config;
+    TopologyFilterConfig config = preset.topology;
     config.particles = o.particles;
     config.alpha = o.alpha;
     config.seed = o.seed;
     config.max_representatives_per_node = o.max_representatives;
+    if (o.likelihood_given->count() > 0) config.likelihood = parseLikelihoodModel(o.likelihood);
+    if (o.slope_given->count() > 0) config.relative_slope = o.relative_slope;
+    if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
+    if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
     if (const std::string problem = config.validate(); !problem.empty())
       throw std::invalid_argument("map: " + problem);
     filter = std::make_unique<TopologyParticleFilter>(config, similarity);
@@ -134,6 +163,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   OfflineMapper mapper(extractor, similarity, segmenter_config, *filter);
   std::vector<FrameTiming> timing;
   std::int64_t refused = 0;
+  // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
+  std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
 
   auto mapPlace = [&](const SegmentedPlace& place) {
     if (place.dropped) return;
@@ -166,7 +197,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       }
       t.fingerprint_ms = msSince(start);
       start = std::chrono::steady_clock::now();
-      const SegmenterStep step = mapper.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
+      frame_fingerprints.push_back(fingerprint);
+      // With several sources, names carry their source's folder ("ref/0001.jpg", "query/0001.jpg") so
+      // they stay unique in frames.csv and pair ground truths can name either traversal.
+      const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
+      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint));
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
@@ -189,9 +224,29 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::ofstream out = openOutput(out_dir / "source.txt");
     for (const std::string& uri : o.sources) out << absoluteSourceUri(uri) << "\n";
   }
+  // Frame-level loop closures (docs/topology.md): each frame on a node seen on an earlier visit gets that
+  // visit's most similar frame, scored by similarity x the place's node probability at its step.
+  FrameLoopColumns loop;
+  {
+    std::vector<std::int64_t> place_of_frame;
+    for (const auto& row : all.frames) place_of_frame.push_back(row.place);
+    loop.place_probability.assign(all.places.size(), 0.0);
+    for (const MappedPlace& step : mapper.steps()) {
+      const auto p = static_cast<std::size_t>(step.place.index);
+      if (p < loop.place_probability.size()) loop.place_probability[p] = step.estimate.current_node_probability;
+    }
+    frame_fingerprints.resize(all.frames.size());
+    const std::vector<FrameMatch> matches = matchFramesToEarlierVisits(
+        place_of_frame, place_nodes, loop.place_probability, frame_fingerprints, similarity, o.loop_min_gap);
+    for (const FrameMatch& m : matches) {
+      loop.match_frame.push_back(m.match_frame);
+      loop.match_score.push_back(m.score);
+    }
+  }
+  frame_fingerprints.clear();
   {
     std::ofstream out = openOutput(out_dir / "frames.csv");
-    writeFramesCsv(out, all, place_nodes);
+    writeFramesCsv(out, all, place_nodes, &loop);
   }
   {
     std::ofstream out = openOutput(out_dir / "places.csv");
@@ -338,6 +393,24 @@ void addMapCommand(CLI::App& app) {
                     ->capture_default_str();
   auto* seed = cmd->add_option("--seed", options->seed, "Seed of the filter's random generator")
                    ->capture_default_str();
+  cmd->add_option("--loop-min-gap", options->loop_min_gap,
+                  "Frame-level loop closures: detections at least this many frames back")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--histogram-weight", options->histogram_weight, "Similarity: weight of the histogram part (default: the preset's)");
+  cmd->add_option("--histogram-gate", options->histogram_gate, "Similarity: histograms as a gate (1) or a weighted part (0)");
+  options->likelihood_given =
+      cmd->add_option("--likelihood", options->likelihood, "Filter likelihood: relative (per query) or absolute (thesis)")
+          ->capture_default_str();
+  options->slope_given =
+      cmd->add_option("--relative-slope", options->relative_slope, "Relative likelihood: logistic slope per z unit")
+          ->capture_default_str();
+  options->offset_given =
+      cmd->add_option("--relative-offset", options->relative_offset, "Relative likelihood: z at which it is 1/2")
+          ->capture_default_str();
+  options->floor_given = cmd->add_option("--relative-sigma-floor", options->relative_sigma_floor,
+                                         "Relative likelihood: smallest spread of the other similarities")
+                             ->capture_default_str();
   auto* reps = cmd->add_option("--max-representatives", options->max_representatives,
                                "Representatives kept per node (oldest dropped)")
                    ->check(CLI::Range(1, kTopologyMaxRepresentatives))

@@ -39,7 +39,8 @@ struct SegmentOptions {
 
 void runSegment(const SegmentOptions& o) {
   const FiedlerSegmenterConfig config = segmenterConfig(o.segmentation, "segment");
-  VpackConfig vpack;
+  const MethodPreset preset = presetOf(o.segmentation, "segment");
+  VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   createRunFolder(o.out);
 
@@ -47,7 +48,7 @@ void runSegment(const SegmentOptions& o) {
   std::unique_ptr<WorkerPool> pool;
   if (o.workers > 1) pool = std::make_unique<WorkerPool>(o.workers, "segment");
   const VpackExtractor extractor(vpack, pool.get());
-  const NgramSimilarity similarity;
+  const NgramSimilarity similarity(preset.similarity);
   OfflineSegmentation pipeline(extractor, similarity, config);
 
   const std::int64_t total = source->frameCountHint();

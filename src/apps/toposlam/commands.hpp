@@ -17,6 +17,7 @@ void addReportCommand(CLI::App& app);
 void addListenCommand(CLI::App& app);
 void addSimilarityCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);
+void addRecognitionCommand(CLI::App& app);
 
 // Sub-benchmarks of `toposlam bench`, each in its module's bench_<module>.cpp (called from command_bench.cpp).
 void addBenchFingerprint(CLI::App& bench);

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   toposlam::cli::addListenCommand(app);
   toposlam::cli::addSimilarityCommand(app);
   toposlam::cli::addLocalizeCommand(app);
+  toposlam::cli::addRecognitionCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

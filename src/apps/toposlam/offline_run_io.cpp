@@ -51,31 +51,90 @@ void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTi
   }
 }
 
+namespace {
+enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut };
+}  // namespace
+
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
   FiedlerSegmenterConfig& c = options.config;
-  command.add_option("--window", c.window, "Segmentation: sliding window in frames")
-      ->capture_default_str()
-      ->check(CLI::Range(3, 1000));
-  command.add_option("--gamma", c.valley.gamma, "Segmentation: minimum lambda2 of a peak, [0, n/(n-1)]")
+  const FiedlerSegmenterConfig d = methodPreset("default").segmentation;
+  c = d;
+  options.cut = toString(d.cut_placement);
+  auto& given = options.given;
+  command.add_option("--preset", options.preset, "Method preset: default (measured on real frames) or thesis")
       ->capture_default_str();
-  command.add_option("--delta", c.valley.delta,
-                     "Segmentation: minimum lambda2 swing between peak and valley, [0, gamma]")
-      ->capture_default_str();
-  command.add_option("--similarity-floor", c.similarity_floor,
-                     "Segmentation: subtracted from every similarity before the affinity, [0, 1)")
-      ->capture_default_str();
-  command.add_option("--min-keypoints", c.min_keypoints,
-                     "Segmentation: drop places whose representative has fewer keypoints")
-      ->capture_default_str();
-  command.add_option("--cut", options.cut,
-                     "Segmentation: where a place ends: window-split (best split of the valley's window) or "
-                     "valley-frame")
-      ->capture_default_str();
+  given.emplace_back(command.add_option("--window-s", c.window_s,
+                                        "Segmentation: sliding window in seconds, from the frames' timestamps "
+                                        "(0 = --window frames)")
+                         ->capture_default_str()
+                         ->check(CLI::Range(0.0, 3600.0)),
+                     kWindowS);
+  given.emplace_back(command.add_option("--window", c.window,
+                                        "Segmentation: window in frames with --window-s 0, else the most frames "
+                                        "it may hold")
+                         ->capture_default_str()
+                         ->check(CLI::Range(3, 1000)),
+                     kWindow);
+  given.emplace_back(command.add_option("--min-window-frames", c.min_window_frames,
+                                        "Segmentation: fewest frames a window in seconds keeps")
+                         ->capture_default_str()
+                         ->check(CLI::Range(3, 1000)),
+                     kMinWindowFrames);
+  given.emplace_back(command.add_option("--gamma", c.valley.gamma, "Segmentation: minimum lambda2 of a peak, [0, n/(n-1)]")
+                         ->capture_default_str(),
+                     kGamma);
+  given.emplace_back(command.add_option("--delta", c.valley.delta,
+                                        "Segmentation: minimum lambda2 swing between peak and valley, [0, gamma]")
+                         ->capture_default_str(),
+                     kDelta);
+  given.emplace_back(command.add_option("--similarity-floor", c.similarity_floor,
+                                        "Segmentation: subtracted from every similarity before the affinity, [0, 1)")
+                         ->capture_default_str(),
+                     kFloor);
+  given.emplace_back(command.add_option("--min-keypoints", c.min_keypoints,
+                                        "Segmentation: drop places whose representative has fewer keypoints")
+                         ->capture_default_str(),
+                     kMinKeypoints);
+  given.emplace_back(command.add_option("--cut", options.cut,
+                                        "Segmentation: where a place ends: window-split (best split of the valley's "
+                                        "window) or valley-frame")
+                         ->capture_default_str(),
+                     kCut);
+}
+
+MethodPreset presetOf(const SegmentationOptions& options, const std::string& command) {
+  try {
+    return methodPreset(options.preset);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(command + ": --preset: " + e.what());
+  }
 }
 
 FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const std::string& command) {
-  FiedlerSegmenterConfig config = options.config;
-  config.cut_placement = parseCutPlacement(options.cut);
+  FiedlerSegmenterConfig config = presetOf(options, command).segmentation;
+  const FiedlerSegmenterConfig& o = options.config;
+  for (const auto& [option, key] : options.given) {
+    if (option->count() == 0) continue;
+    switch (key) {
+      case kWindowS: config.window_s = o.window_s; break;
+      case kWindow: config.window = o.window; break;
+      case kMinWindowFrames: config.min_window_frames = o.min_window_frames; break;
+      case kGamma: config.valley.gamma = o.valley.gamma; break;
+      case kDelta: config.valley.delta = o.valley.delta; break;
+      case kFloor: config.similarity_floor = o.similarity_floor; break;
+      case kMinKeypoints: config.min_keypoints = o.min_keypoints; break;
+      case kCut: config.cut_placement = parseCutPlacement(options.cut); break;
+    }
+  }
+  // --window alone asks for a window of that many frames (the time window is for --window-s).
+  bool window_given = false, window_s_given = false;
+  for (const auto& [option, key] : options.given) {
+    window_given = window_given || (key == kWindow && option->count() > 0);
+    window_s_given = window_s_given || (key == kWindowS && option->count() > 0);
+  }
+  if (window_given && !window_s_given) config.window_s = 0.0;
+  // A frame window smaller than the time window's lower bound: the bound follows it.
+  if (config.min_window_frames > config.window) config.min_window_frames = config.window;
   if (const std::string problem = config.validate(); !problem.empty()) {
     throw std::invalid_argument(command + ": " + problem);
   }

@@ -8,10 +8,12 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "toposlam/config/method_preset.hpp"
 #include "toposlam/io/frame_source.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 
@@ -34,13 +36,19 @@ struct FrameTiming {
 };
 void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTiming>& rows);
 
-/// --window, --gamma, --delta, --similarity-floor, --min-keypoints, --cut.
+/// --preset plus --window-s, --window, --min-window-frames, --gamma, --delta, --similarity-floor,
+/// --min-keypoints, --cut: the preset gives every stage's defaults, an option given overrides its key.
 struct SegmentationOptions {
-  FiedlerSegmenterConfig config;
-  std::string cut = toString(FiedlerSegmenterConfig{}.cut_placement);
+  std::string preset = "default";
+  FiedlerSegmenterConfig config;  ///< bound to the options; only those given are used
+  std::string cut;
+  std::vector<std::pair<CLI::Option*, int>> given;  ///< option and which key it sets (offline_run_io.cpp)
 };
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options);
-/// The validated segmenter config; throws std::invalid_argument "<command>: <key>: <problem>".
+/// The method preset named by --preset (every stage's settings).
+MethodPreset presetOf(const SegmentationOptions& options, const std::string& command);
+/// The preset's segmenter config with the given options applied, validated; throws
+/// std::invalid_argument "<command>: <key>: <problem>".
 FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const std::string& command);
 
 }  // namespace toposlam::cli

@@ -1,0 +1,44 @@
+// Named settings of the whole method: see method_preset.hpp.
+#include "toposlam/config/method_preset.hpp"
+
+#include <stdexcept>
+
+#include "toposlam/matching/similarity_preset.hpp"
+
+namespace toposlam {
+
+MethodPreset methodPreset(const std::string& name) {
+  const SimilarityPreset similarity = similarityPreset(name);  // throws for unknown names
+  MethodPreset p;
+  p.name = name;
+  p.fingerprint = similarity.fingerprint;
+  p.similarity = similarity.similarity;
+  if (name == "default") {
+    p.segmentation.window_s = 6.0;
+    p.segmentation.window = 100;
+    p.segmentation.min_window_frames = 5;
+    p.topology.likelihood = LikelihoodModel::Relative;
+    p.topology.relative_slope = 2.0;
+    p.topology.relative_offset = 8.0;
+    p.topology.relative_sigma_floor = 0.02;
+  }
+  if (name == "thesis") {
+    p.segmentation.window_s = 0.0;  // n = 25 frames (section 4.2), at the thesis' ~5 fps
+    p.segmentation.window = 25;
+    p.segmentation.valley = ValleyDetectorConfig{0.5, 0.25};
+    p.segmentation.similarity_floor = 0.0;
+    p.segmentation.min_keypoints = 15;
+    p.segmentation.cut_placement = CutPlacement::ValleyFrame;
+    p.topology.likelihood = LikelihoodModel::Absolute;
+    p.topology.particles = 500;
+    p.topology.alpha = 15.0;
+    p.topology.new_node_probability = 0.05;
+    p.topology.gamma_shape = 10.0;
+    p.topology.gamma_scale = 0.25;
+  }
+  return p;
+}
+
+std::vector<std::string> methodPresetNames() { return similarityPresetNames(); }
+
+}  // namespace toposlam
