@@ -1,0 +1,209 @@
+// From controller messages to robot motion, and the emulated controller through the whole host side
+// (bytes -> decoder -> estimator), with stops, speed changes, drops, bit errors and garbage.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "toposlam/firmware/emulator.hpp"
+#include "toposlam/firmware/motion_link.hpp"
+
+using namespace toposlam::firmware;
+
+namespace {
+
+struct Totals {
+  double forward = 0, lateral = 0, turn = 0;
+  int samples = 0, moving = 0, standing = 0;
+};
+
+Totals runEmulator(const EmulatorConfig& config, LinkProtocol protocol, std::vector<MotionSample>* out = nullptr) {
+  ControllerEmulator emulator(config);
+  MotionLink link(protocol);
+  Totals t;
+  std::vector<std::uint8_t> bytes;
+  const double step = 0.05;  // the host reads every 50 ms
+  for (double now = step; now <= emulator.duration() + 1e-9; now += step) {
+    bytes.clear();
+    emulator.advanceTo(now, bytes);
+    link.feed(bytes, static_cast<std::int64_t>(now * 1e6) + 1000, [&](const MotionSample& s) {
+      t.forward += s.forward_m;
+      t.lateral += s.lateral_m;
+      t.turn += s.turn_rad;
+      ++t.samples;
+      (s.moving ? t.moving : t.standing) += 1;
+      if (out) out->push_back(s);
+    });
+  }
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN wheel odometry WHEN the robot drives straight, turns and the counters wrap THEN the increments "
+          "follow",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  twl_wheel_odometry_t m{1000000, 0, 0, 300, TWL_ODOM_DRIVING, 0};
+  CHECK_FALSE(e.onWheel(m, 5000000).has_value());  // the first message is the reference
+  m.time_us += 100000;
+  m.left_um = 50000;
+  m.right_um = 50000;
+  auto s = e.onWheel(m, 5100000 + 300);
+  REQUIRE(s);
+  CHECK(s->forward_m == Approx(0.05));
+  CHECK(s->turn_rad == Approx(0.0));
+  CHECK(s->linear_velocity_mps == Approx(0.5));
+  CHECK(s->moving);
+  CHECK(s->utime == 5100000);  // controller 1.1 s + the smallest offset seen (4 s)
+
+  // Turning on the spot, counter-clockwise: right wheel forward, left back; 0.3 m track.
+  m.time_us += 100000;
+  m.left_um -= 15000;
+  m.right_um += 15000;
+  s = e.onWheel(m, 5200000);
+  REQUIRE(s);
+  CHECK(s->forward_m == Approx(0.0).margin(1e-12));
+  CHECK(s->turn_rad == Approx(0.1));
+
+  // The left counter wraps past INT32_MAX: the difference is still +10 mm.
+  MotionEstimator w;
+  twl_wheel_odometry_t a{0, 2147480000, 0, 300, 0, 0};
+  w.onWheel(a, 0);
+  a.time_us = 100000;
+  a.left_um = static_cast<std::int32_t>(2147480000u + 10000u);
+  a.right_um = 10000;
+  s = w.onWheel(a, 100000);
+  REQUIRE(s);
+  CHECK(s->forward_m == Approx(0.01));
+  CHECK_FALSE(s->moving == false);  // 0.1 m/s > threshold although the flag says idle
+}
+
+TEST_CASE("GIVEN a controller that restarts WHEN its clock steps back THEN no increment spans the restart",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  twl_wheel_odometry_t m{5000000, 1000000, 1000000, 300, 0, 0};
+  e.onWheel(m, 10000000);
+  m.time_us = 5100000;
+  CHECK(e.onWheel(m, 10100000));
+  // Restart: clock and counters back near zero. A naive difference would be -1 m.
+  m.time_us = 200000;
+  m.left_um = m.right_um = 0;
+  CHECK_FALSE(e.onWheel(m, 10300000).has_value());
+  m.time_us = 300000;
+  m.left_um = m.right_um = 20000;
+  const auto s = e.onWheel(m, 10400000);
+  REQUIRE(s);
+  CHECK(s->forward_m == Approx(0.02));
+  CHECK(s->utime == 10400000);  // re-mapped: the new offset is 10.1 s
+  CHECK(e.counters().restarts == 1);
+}
+
+TEST_CASE("GIVEN body velocities WHEN integrated THEN trapezoids, and a long gap is not invented", "[firmware][motion]") {
+  MotionEstimator e;
+  twl_body_velocity_t v{0, 1000, 0, 500};
+  e.onWheel(v, 0);
+  v.time_us = 100000;
+  auto s = e.onWheel(v, 100000);
+  REQUIRE(s);
+  CHECK(s->forward_m == Approx(0.1));
+  CHECK(s->turn_rad == Approx(0.05));
+  v.time_us = 2000000;  // 1.9 s of silence: longer than max_gap_s
+  s = e.onWheel(v, 2000000);
+  REQUIRE(s);
+  CHECK(s->forward_m == 0.0);
+  CHECK(e.counters().gaps == 1);
+}
+
+TEST_CASE("GIVEN MAVLink ODOMETRY heading east WHEN the drone moves east and yaws right THEN forward and a clockwise "
+          "(negative) turn",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  mavlink::Odometry o;
+  const double yaw = 3.14159265358979 / 2;  // facing east (NED yaw is clockwise from north)
+  o.q[0] = static_cast<float>(std::cos(yaw / 2));
+  o.q[3] = static_cast<float>(std::sin(yaw / 2));
+  o.time_usec = 1000000;
+  e.onMavlink(o, 1000000);
+  o.time_usec = 1100000;
+  o.y = 0.2f;  // east
+  const double yaw2 = yaw + 0.1;
+  o.q[0] = static_cast<float>(std::cos(yaw2 / 2));
+  o.q[3] = static_cast<float>(std::sin(yaw2 / 2));
+  o.vx = 2.0f;
+  o.yawspeed = 1.0f;
+  const auto s = e.onMavlink(o, 1100000);
+  REQUIRE(s);
+  CHECK(s->forward_m == Approx(0.2).margin(1e-6));
+  CHECK(s->lateral_m == Approx(0.0).margin(1e-6));
+  CHECK(s->turn_rad == Approx(-0.1).margin(1e-6));
+  CHECK(s->linear_velocity_mps == Approx(2.0));
+  CHECK(s->angular_velocity_rps == Approx(-1.0));
+
+  AND_THEN("a position in an unsupported frame is refused and counted") {
+    o.frame_id = 4;  // MAV_FRAME_LOCAL_ENU
+    CHECK_FALSE(e.onMavlink(o, 1200000));
+    CHECK(e.counters().invalid == 1);
+  }
+}
+
+TEST_CASE("GIVEN the emulated office route with three stops and a slow stretch WHEN sent over each link with damage "
+          "THEN the host's distance and standing time match the truth",
+          "[firmware][motion][emulator]") {
+  EmulatorConfig c;
+  // 20 s at 0.5 m/s, a 10 s stop, 15 s at a third of the speed, a 10 s stop, a turn, 10 s at 0.5, a stop.
+  c.profile = *parseProfile("20@0.5,10@0,15@0.1667,10@0,3@0@0.5236,10@0.5,10@0");
+  c.rate_hz = 50;
+  c.garbage_probability = 0.05;
+  c.corrupt_probability = 0.02;
+  c.drop_probability = 0.02;
+  c.seed = 7;
+  const double truth_distance = 20 * 0.5 + 15 * 0.1667 + 10 * 0.5;
+
+  SECTION("wheel odometry: cumulative counters lose no distance to drops") {
+    c.messages = EmulatedMessages::WheelOdometry;
+    std::vector<MotionSample> samples;
+    const Totals t = runEmulator(c, LinkProtocol::Wheel, &samples);
+    // Exact but for the travel before the first frame that got through (the reference): one 20 ms step.
+    CHECK(t.forward == Approx(truth_distance).margin(0.5 * 0.02 + 1e-3));
+    CHECK(t.turn == Approx(3 * 0.5236).margin(1e-3));
+    // About 30 s of 78 standing, at 50 Hz minus drops and damage.
+    CHECK(t.standing > 30 * 50 * 0.85);
+    CHECK(t.standing < 30 * 50 * 1.02);
+  }
+  SECTION("body velocity: integrated, losing only what the drops hid") {
+    c.messages = EmulatedMessages::BodyVelocity;
+    const Totals t = runEmulator(c, LinkProtocol::Wheel);
+    CHECK(t.forward == Approx(truth_distance).margin(0.02 * truth_distance));
+  }
+  SECTION("MAVLink ODOMETRY, with MAVLink 1, signed and unknown traffic around it") {
+    c.messages = EmulatedMessages::MavlinkOdometry;
+    c.other_mavlink_traffic = true;
+    const Totals t = runEmulator(c, LinkProtocol::Mavlink);
+    CHECK(t.forward == Approx(truth_distance).margin(1e-3 * truth_distance));
+    CHECK(t.turn == Approx(3 * 0.5236).margin(1e-3));
+  }
+  SECTION("MAVLink LOCAL_POSITION_NED + ATTITUDE") {
+    c.messages = EmulatedMessages::MavlinkLocalPosition;
+    const Totals t = runEmulator(c, LinkProtocol::Mavlink);
+    CHECK(t.forward == Approx(truth_distance).margin(1e-3 * truth_distance));
+  }
+}
+
+TEST_CASE("GIVEN the same config WHEN the emulator runs twice THEN the bytes are identical", "[firmware][emulator]") {
+  EmulatorConfig c;
+  c.garbage_probability = 0.3;
+  c.corrupt_probability = 0.1;
+  c.seed = 99;
+  ControllerEmulator a(c), b(c);
+  std::vector<std::uint8_t> x, y;
+  a.advanceTo(3.0, x);
+  b.advanceTo(3.0, y);
+  CHECK(x == y);
+  CHECK(a.truth().motion_frames == 150);
+  std::string error;
+  CHECK_FALSE(parseProfile("10@", &error));
+  CHECK_FALSE(parseProfile("0@1", &error));
+  CHECK_FALSE(parseProfile("1@2@3@4", &error));
+  CHECK(parseProfile("1@2@3")->at(0).turn_rate_rps == 3.0);
+}
