@@ -189,6 +189,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     map.text("path", c.pipeline.map_path, 4096, true);
     map.flag("load_at_start", c.load_map_at_start);
     map.real("save_period_s", c.pipeline.map_save_period_s, 0, 86400, " seconds (0 = only at stop)");
+    map.real("max_mb", c.map_max_mb, 1, 65536, " MB");
     map.finish();
   }
   {
@@ -320,6 +321,8 @@ DaemonConfig::DaemonConfig() { pipeline.map_path = "map.tsm"; }
 
 std::string DaemonConfig::validate() const {
   if (source.empty()) return "source: must not be empty (e.g. sim:office?route=loop2 or v4l2:/dev/video0)";
+  if (!(map_max_mb >= 1 && map_max_mb <= 65536))
+    return "map.max_mb: " + std::to_string(map_max_mb) + " is out of range, allowed [1, 65536] MB";
   if (lcm.url.empty()) return "lcm.url: must not be empty (e.g. udpm://239.255.76.67:7667?ttl=0)";
   if (lcm.jpeg_quality < 1 || lcm.jpeg_quality > 100)
     return "lcm.jpeg_quality: " + std::to_string(lcm.jpeg_quality) + " is out of range, allowed 1 .. 100";

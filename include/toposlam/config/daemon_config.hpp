@@ -38,6 +38,7 @@ struct DaemonConfig {
   std::string source = "sim:office?route=loop2";
   LcmSettings lcm;
   bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
+  double map_max_mb = 256;        ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
   bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
   PipelineConfig pipeline;        ///< queues, threads, budgets; map.path and map.save_period_s land here
   int fingerprint_workers = 2;    ///< fingerprint.workers: WorkerPool size incl. the fingerprint thread

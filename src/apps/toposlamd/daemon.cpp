@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -107,18 +108,33 @@ int runDaemon(const DaemonConfig& config) {
   Assembly parts(config, clock, config.source);
   spdlog::info("toposlamd: source {}", parts.source->describe());
 
-  if (config.load_map_at_start && !pipeline_config.map_path.empty() &&
-      std::filesystem::exists(pipeline_config.map_path)) {
-    try {
-      parts.topology->loadMap(pipeline_config.map_path);
-      spdlog::info("toposlamd: resumed the map {} ({} places)", pipeline_config.map_path, parts.topology->observations());
-    } catch (const std::exception& e) {
-      // A damaged map must not keep the robot from starting: keep it aside for a human, start afresh.
-      const std::string aside = pipeline_config.map_path + ".damaged";
-      std::error_code ec;
-      std::filesystem::rename(pipeline_config.map_path, aside, ec);
-      spdlog::error("toposlamd: cannot load the map {} ({}); moved it to {} and starting a new map",
-                    pipeline_config.map_path, e.what(), aside);
+  // One writer per map: a second daemon (or `toposlam map`) on the same file is refused here, before
+  // anything is loaded or saved. Then the temporary files of saves a kill -9 interrupted are removed.
+  std::optional<MapLock> map_lock;
+  if (!pipeline_config.map_path.empty()) {
+    map_lock = MapLock::acquire(pipeline_config.map_path);
+    if (const int orphans = MapStore::removeOrphanedTemporaries(pipeline_config.map_path); orphans > 0)
+      spdlog::info("toposlamd: removed {} temporary file(s) of interrupted map saves beside {}", orphans,
+                   pipeline_config.map_path);
+  }
+  const MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
+  parts.topology->setMapSettings(map_settings);
+  if (config.load_map_at_start && !pipeline_config.map_path.empty()) {
+    // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
+    // human under a timestamped name (never over an earlier one) and the robot starts from what is left.
+    const auto max_bytes = static_cast<std::uint64_t>(config.map_max_mb * 1024.0 * 1024.0);
+    RecoveredMap recovered = MapStore::recover(pipeline_config.map_path, *parts.similarity, max_bytes);
+    for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
+    if (recovered.map) {
+      const std::string refusal =
+          MapStore::checkSettings(recovered.map->settings, map_settings, recovered.loaded_from.string());
+      if (!refusal.empty()) throw MapStoreError(refusal);
+      parts.topology->adoptMap(std::move(*recovered.map));
+      spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
+                   parts.topology->observations(),
+                   recovered.problems.empty() ? "" : ", the newest file that loads");
+    } else if (!recovered.problems.empty()) {
+      spdlog::error("toposlamd: no map file of {} loads; starting a new map", pipeline_config.map_path);
     }
   }
 
