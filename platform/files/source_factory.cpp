@@ -10,6 +10,7 @@
 #include <condition_variable>
 
 #include "toposlam/io/file_sources.hpp"
+#include "toposlam/io/image_file.hpp"
 #include "toposlam/io/sim_source.hpp"
 
 namespace toposlam {
@@ -84,9 +85,10 @@ class RateLimitedSource : public FrameSource {
 };
 
 std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
-  uri.requireOnly({});
+  uri.requireOnly({"max_pixels"});
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': images: needs a folder, file or glob");
-  return std::make_unique<ImageFilesSource>(uri.path, uri.getDouble("rate", 1.0, 1e-3, 1e4));
+  return std::make_unique<ImageFilesSource>(uri.path, uri.getDouble("rate", 1.0, 1e-3, 1e4),
+                                            uri.getInt("max_pixels", kDefaultMaxImagePixels, 1, 1LL << 32));
 }
 
 std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
@@ -101,7 +103,7 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, SchemeEntry> schemes;
   Registry() {
-    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?rate=HZ]"};
+    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?rate=HZ&max_pixels=N]"};
     schemes["video"] = {openVideo, "video:FILE[?rate=HZ]"};
     schemes["sim"] = {openSim,
                       "sim:WORLD?route=R&fps=F&size=WxH&seed=S[&speed=&fov=&light=day|night|warm|cool&noise=&people=&"
