@@ -1,6 +1,11 @@
-// toposlamd's body; see daemon.hpp. Signals: SIGTERM/SIGINT/SIGHUP are blocked in every thread (the mask is
-// set before any thread exists, threads inherit it) and taken synchronously by the main thread with
-// sigtimedwait(), so no work happens in a signal handler.
+// toposlamd's body; see daemon.hpp. Signals are blocked in every thread (the mask is set before any thread
+// exists, threads inherit it) and taken synchronously by the main thread with sigtimedwait(), so no work
+// happens in a signal handler:
+//   SIGTERM, SIGINT, SIGHUP, SIGQUIT   finish the filter step in progress, save the map, exit 0
+//   SIGUSR1, SIGUSR2, SIGALRM          logged and otherwise ignored (their default would kill the daemon
+//                                      without a final save)
+//   SIGPIPE                            ignored: a write to a closed pipe (a log reader gone) fails with
+//                                      EPIPE, which the writers treat as a failed write, not as the end
 #include "daemon.hpp"
 
 #include <signal.h>
@@ -10,6 +15,8 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <iterator>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -33,12 +40,19 @@ namespace toposlam::daemon {
 
 namespace {
 
-sigset_t stopSignals() {
+constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT};
+constexpr int kIgnoredSignals[] = {SIGUSR1, SIGUSR2, SIGALRM};
+
+bool isStopSignal(int signal) {
+  return std::find(std::begin(kStopSignals), std::end(kStopSignals), signal) != std::end(kStopSignals);
+}
+
+/// Every signal the main thread takes with sigtimedwait (stop and ignored ones).
+sigset_t handledSignals() {
   sigset_t set;
   sigemptyset(&set);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGHUP);
+  for (int s : kStopSignals) sigaddset(&set, s);
+  for (int s : kIgnoredSignals) sigaddset(&set, s);
   return set;
 }
 
@@ -97,8 +111,9 @@ std::string resolveMapPath(const std::string& path) {
 }
 
 int runDaemon(const DaemonConfig& config) {
-  const sigset_t signals = stopSignals();
+  const sigset_t signals = handledSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // before any thread exists: all inherit it
+  std::signal(SIGPIPE, SIG_IGN);                  // EPIPE instead of death on a closed log pipe
 
   SystemdNotifier notifier;
   SteadyClock clock;
@@ -165,7 +180,9 @@ int runDaemon(const DaemonConfig& config) {
   while (!pipeline.finished()) {
     // Once stopping, look for the end more often so the exit follows the map save closely.
     const int signal = waitForSignal(signals, stopping ? std::min(tick_s, 0.1) : tick_s);
-    if (signal != 0 && !stopping) {
+    if (signal != 0 && !isStopSignal(signal)) {
+      spdlog::info("toposlamd: {} received: ignored (stop with SIGTERM, SIGINT, SIGHUP or SIGQUIT)", strsignal(signal));
+    } else if (signal != 0 && !stopping) {
       stopping = true;
       spdlog::info("toposlamd: {} received: finishing the filter step in progress and saving the map",
                    strsignal(signal));
