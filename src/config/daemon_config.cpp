@@ -2,6 +2,7 @@
 #include "toposlam/config/daemon_config.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
@@ -309,6 +310,25 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
   top.finish();
 }
 
+// yaml-cpp keeps both entries of a repeated key and look-ups see only the first, so the second would be
+// ignored silently: refused, naming the key and its line.
+void refuseDuplicateKeys(const YAML::Node& node, const std::string& path) {
+  if (node.IsSequence()) {
+    for (const YAML::Node& item : node) refuseDuplicateKeys(item, path);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::set<std::string> seen;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string("?");
+    const std::string full = path.empty() ? key : path + "." + key;
+    if (!seen.insert(key).second)
+      throw ConfigError("duplicate key '" + full + "' (line " + std::to_string(entry.first.Mark().line + 1) +
+                        "); give each key once");
+    refuseDuplicateKeys(entry.second, full);
+  }
+}
+
 // Stage validate() messages are "<key>: ..." relative to the stage (fingerprint's are already full).
 std::string prefixed(const std::string& section, const std::string& problem) {
   if (problem.empty() || problem.rfind(section + ".", 0) == 0) return problem;
@@ -355,9 +375,19 @@ std::string DaemonConfig::validate() const {
 DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin) {
   YAML::Node root;
   try {
-    root = YAML::Load(yaml_text);
+    // A second document ("---") would be ignored silently by YAML::Load: refused instead.
+    std::vector<YAML::Node> documents = YAML::LoadAll(yaml_text);
+    if (documents.size() > 1)
+      throw ConfigError(origin + ": holds " + std::to_string(documents.size()) +
+                        " YAML documents (a '---' line starts another); toposlamd reads exactly one");
+    if (!documents.empty()) root = documents.front();
   } catch (const YAML::Exception& e) {
     throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  try {
+    refuseDuplicateKeys(root, "");
+  } catch (const ConfigError& e) {
+    throw ConfigError(origin + ": " + e.what());
   }
   DaemonConfig config;
   try {
@@ -372,11 +402,21 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
 }
 
 DaemonConfig loadDaemonConfig(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw ConfigError("the config file '" + path + "' is a folder; give the YAML file in it (e.g. " +
+                      (std::filesystem::path(path) / "toposlam.yaml").string() + ")");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError("cannot read the config file '" + path + "' (does it exist and is it readable?)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseDaemonConfig(text.str(), path);
+  // Read at most the cap (+1 to notice more): /dev/zero or a runaway file never reads forever.
+  std::string text(kMaxConfigBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw ConfigError("cannot read the config file '" + path + "'");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxConfigBytes)
+    throw ConfigError("the config file '" + path + "' is larger than " + std::to_string(kMaxConfigBytes >> 10) +
+                      " KiB; is it really a toposlam config?");
+  return parseDaemonConfig(text, path);
 }
 
 }  // namespace toposlam

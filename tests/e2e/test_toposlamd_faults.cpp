@@ -40,9 +40,10 @@ std::string readText(const fs::path& path) {
 }
 
 /// toposlamd started with `args` (after the binary), stdout and stderr to `log`.
-pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args) {
+pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {}) {
   const pid_t pid = fork();
   if (pid == 0) {
+    if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
     const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1);
     dup2(fd, 2);
@@ -85,8 +86,8 @@ bool waitForLog(const fs::path& log, const std::string& text, double limit_s) {
 }
 
 /// Runs toposlamd to the end of a finite source; returns its exit code.
-int runDaemon(const fs::path& log, const std::vector<std::string>& args) {
-  return waitForExit(startDaemon(log, args), 60.0);
+int runDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {}) {
+  return waitForExit(startDaemon(log, args, cwd), 60.0);
 }
 
 fs::path freshDirectory(const std::string& name) {
@@ -226,4 +227,15 @@ SCENARIO("GIVEN a running toposlamd WHEN a second one starts on its map, and it 
   CHECK(code == 0);
   CHECK_THAT(log, Catch::Contains("received: finishing the filter step"));
   CHECK(fs::exists(map));
+}
+
+SCENARIO("GIVEN --map \"\" WHEN toposlamd runs THEN no map file is written (not even ./map.tsm)") {
+  const fs::path dir = freshDirectory("no-map");
+  const fs::path frames = sampleFolder(dir, 3);
+  unsetenv("STATE_DIRECTORY");
+  const int code = runDaemon(dir / "run.log", {"--source", "images:" + frames.string(), "--map", "", "--lcm-url", "memq://"}, dir);
+  INFO(readText(dir / "run.log"));
+  CHECK(code == 0);
+  CHECK_FALSE(fs::exists(dir / "map.tsm"));
+  CHECK(countPrefix(dir, "map.tsm") == 0);
 }

@@ -57,7 +57,10 @@ struct DaemonConfig {
 /// Parses YAML text onto the defaults. `origin` names the text in messages (a file name).
 /// Throws ConfigError on syntax errors, unknown keys, wrong types and out-of-range values.
 DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin = "config");
-/// Reads and parses a file; ConfigError if it cannot be read.
+/// A config file larger than this is refused (bytes).
+inline constexpr std::size_t kMaxConfigBytes = 1 << 20;
+/// Reads and parses a file; ConfigError if it cannot be read, is a folder or is over kMaxConfigBytes.
+/// A repeated key or a second YAML document is refused (parseDaemonConfig).
 DaemonConfig loadDaemonConfig(const std::string& path);
 
 }  // namespace toposlam

@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
                                                  defaultConfigPath() + " if it exists, else built-in defaults");
   app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
-  app.add_option("--map", map_path, "override `map.path` (relative paths resolve against $STATE_DIRECTORY)");
+  auto* map_option = app.add_option("--map", map_path,
+                                    "override `map.path` (relative paths resolve against $STATE_DIRECTORY; \"\" = never saved)");
   app.add_option("--lcm-url", lcm_url, "override `lcm.url`");
   app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
   app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
       config_path = "(built-in defaults)";
     }
     if (!source.empty()) config.source = source;
-    if (!map_path.empty()) config.pipeline.map_path = map_path;
+    if (map_option->count() > 0) config.pipeline.map_path = map_path;  // --map "" means no map file
     if (!lcm_url.empty()) config.lcm.url = lcm_url;
     if (overflow == "block") config.pipeline.queues.overflow = toposlam::QueueOverflow::Block;
     if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
