@@ -344,6 +344,14 @@ std::string DaemonConfig::validate() const {
   if (!(map_max_mb >= 1 && map_max_mb <= 65536))
     return "map.max_mb: " + std::to_string(map_max_mb) + " is out of range, allowed [1, 65536] MB";
   if (lcm.url.empty()) return "lcm.url: must not be empty (e.g. udpm://239.255.76.67:7667?ttl=0)";
+  {
+    // The LCM providers liblcm knows; anything else would only fail when the daemon opens it.
+    static const char* const kProviders[] = {"udpm://", "mpudpm://", "memq://", "file://", "tcpq://"};
+    bool known = false;
+    for (const char* p : kProviders) known = known || lcm.url.rfind(p, 0) == 0;
+    if (!known)
+      return "lcm.url: '" + lcm.url + "' is not an LCM URL, expected udpm://, mpudpm://, memq://, file:// or tcpq://";
+  }
   if (lcm.jpeg_quality < 1 || lcm.jpeg_quality > 100)
     return "lcm.jpeg_quality: " + std::to_string(lcm.jpeg_quality) + " is out of range, allowed 1 .. 100";
   if (fingerprint_workers < 1 || fingerprint_workers > 64)

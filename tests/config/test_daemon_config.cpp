@@ -203,6 +203,8 @@ SCENARIO("A folder, an endless file, a repeated key or a second document is refu
   CHECK(errorOf("").empty());
   CHECK(errorOf("---\nsource: images:a\n").empty());
   CHECK_THAT(errorOf("map:\n  max_mb: 0\n"), Catch::Contains("map.max_mb"));
+  CHECK_THAT(errorOf("lcm:\n  url: udp-multicast-please\n"), Catch::Contains("lcm.url: 'udp-multicast-please' is not an LCM URL"));
+  CHECK(errorOf("lcm:\n  url: memq://\n").empty());
 }
 
 SCENARIO("DaemonConfig::validate() names keys by their YAML path") {

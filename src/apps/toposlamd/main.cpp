@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
+#include "sources.hpp"
 #include "toposlam/config/daemon_config.hpp"
 
 namespace {
@@ -79,6 +80,8 @@ int main(int argc, char** argv) {
     if (std::string problem = config.validate(); !problem.empty())
       throw toposlam::ConfigError("command line: " + problem);
     if (check_only) {
+      if (const std::string problem = toposlam::daemon::checkSourceUri(config.source); !problem.empty())
+        throw toposlam::ConfigError(config_path + ": source: " + problem);
       std::cout << "toposlamd: config OK: " << config_path << "\n";
       return 0;
     }
