@@ -239,3 +239,27 @@ SCENARIO("GIVEN --map \"\" WHEN toposlamd runs THEN no map file is written (not 
   CHECK_FALSE(fs::exists(dir / "map.tsm"));
   CHECK(countPrefix(dir, "map.tsm") == 0);
 }
+
+SCENARIO("GIVEN toposlamd whose log pipe is closed (the reader gone) WHEN it runs THEN it is not killed by SIGPIPE "
+         "and saves its map") {
+  const fs::path dir = freshDirectory("closed-pipe");
+  const fs::path frames = sampleFolder(dir, 3);
+  const fs::path map = dir / "map.tsm";
+  int pipe_fds[2];
+  REQUIRE(pipe(pipe_fds) == 0);
+  close(pipe_fds[0]);  // no reader: every log write fails with EPIPE (and raises SIGPIPE)
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(pipe_fds[1], 1);
+    dup2(pipe_fds[1], 2);
+    signal(SIGPIPE, SIG_DFL);  // as a shell would start it
+    const std::string binary = TOPOSLAMD_BINARY;
+    execl(binary.c_str(), binary.c_str(), "--source", ("images:" + frames.string()).c_str(), "--map", map.c_str(),
+          "--lcm-url", "memq://", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(pipe_fds[1]);
+  const int code = waitForExit(pid, 60.0);
+  CHECK(code == 0);  // 141 = killed by SIGPIPE
+  CHECK(fs::exists(map));
+}

@@ -1,6 +1,7 @@
 // toposlamd: the real-time topological SLAM service. Reads one config (default
 // $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
 // runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
+#include <csignal>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -40,6 +41,8 @@ std::string defaultConfigPath() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
   app.set_version_flag("--version", "toposlamd 0.1.0");
   std::string config_path;
