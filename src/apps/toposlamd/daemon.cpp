@@ -191,7 +191,14 @@ int runDaemon(const DaemonConfig& config) {
       pipeline.requestStop();
     }
     if (watchdog_s > 0 && pipeline.healthy()) notifier.watchdog();
-    if (!stopping) notifier.status(statusLine(pipeline.status()));  // says when the camera is reconnecting
+    if (!stopping) {
+      // Says when the camera is reconnecting; a stalled stage (no heartbeat while inside its work) is named,
+      // since that is also why the watchdog pings stop.
+      const std::string stalled = pipeline.stalledStages();
+      notifier.status(stalled.empty() ? statusLine(pipeline.status())
+                                      : "stalled: " + stalled + " without progress (watchdog pings withheld); " +
+                                            statusLine(pipeline.status()));
+    }
   }
   pipeline.wait();
   receiving.store(false);
