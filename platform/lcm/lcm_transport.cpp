@@ -255,7 +255,9 @@ class WireWalker {
           break;
         case WireField::String: {
           std::int32_t n = 0;
-          if (!int32(n) || n < 0 || !skip(static_cast<std::size_t>(n))) return false;
+          // The length counts the terminating NUL, so it is >= 1: the generated decoder assigns len - 1
+          // bytes, and 0 made that a length_error (found by fuzz_lcm_messages).
+          if (!int32(n) || n < 1 || !skip(static_cast<std::size_t>(n))) return false;
           break;
         }
         case WireField::Length:

@@ -113,6 +113,10 @@ TEST_CASE("GIVEN an 8000x8000 PNG WHEN read with the default cap THEN refused; w
   writeBytes(big, pngClaiming(8000, 8000));
   CHECK_THROWS_WITH(readImageFileChecked(big.string(), cv::IMREAD_COLOR),
                     Catch::Contains("8000x8000 pixels (64.0 megapixels) is over the cap of 16.8 megapixels"));
+  // Sides near 2^32: refused without overflowing the product (found by fuzz_image_header).
+  writeBytes(big, pngClaiming(0xFFFFFFFFu, 0xFFFFFFF0u));
+  CHECK_THROWS_WITH(readImageFileChecked(big.string(), cv::IMREAD_COLOR), Catch::Contains("a side alone"));
+  writeBytes(big, pngClaiming(8000, 8000));
   // Under a cap it fits, the decoder gets it (and refuses the stale checksum: an error, not a crash).
   CHECK_THROWS_AS(readImageFileChecked(big.string(), cv::IMREAD_COLOR, 100'000'000), ImageReadError);
 }

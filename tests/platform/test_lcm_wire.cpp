@@ -57,6 +57,10 @@ TEST_CASE("GIVEN encoded place, status and topology messages WHEN checked THEN t
   std::vector<std::uint8_t> bad_string = status_bytes;
   putInt32(bad_string, 8 + 8, -5);  // the state string's length
   CHECK_FALSE(lcmArrayLengthsFit("status", bad_string.data(), bad_string.size()));
+  // Length 0 (no room even for the NUL): the generated decoder would assign -1 bytes (found by
+  // fuzz_lcm_messages).
+  putInt32(bad_string, 8 + 8, 0);
+  CHECK_FALSE(lcmArrayLengthsFit("status", bad_string.data(), bad_string.size()));
 
   toposlam_lcm::topology_t topology{};
   topology.num_nodes = 1;
