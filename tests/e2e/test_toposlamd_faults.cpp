@@ -144,11 +144,11 @@ SCENARIO("GIVEN a damaged map.tsm and a good .prev WHEN toposlamd starts THEN it
   CHECK(countPrefix(dir, "map.tsm.damaged-") == 1);
   CHECK(readText(dir / "map.tsm.prev") == good_prev);  // the last good map was not pushed out
 
-  WHEN("it happens again") {
-    flipMiddleByte(map);
-    CHECK(runDaemon(dir / "run4.log", daemonArgs(frames, map)) == 0);
-    THEN("the earlier damaged file is kept beside the new one") { CHECK(countPrefix(dir, "map.tsm.damaged-") == 2); }
-  }
+  // It happens again (inline, not a WHEN section, so the daemon runs above are not repeated): the earlier
+  // damaged file is kept beside the new one.
+  flipMiddleByte(map);
+  CHECK(runDaemon(dir / "run4.log", daemonArgs(frames, map)) == 0);
+  CHECK(countPrefix(dir, "map.tsm.damaged-") == 2);
 }
 
 SCENARIO("GIVEN temporary files a kill -9 left and a frame claiming 65500x65500 WHEN toposlamd runs THEN the "
