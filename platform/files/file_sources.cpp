@@ -14,6 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include "toposlam/core/natural_order.hpp"
+#include "toposlam/io/image_file.hpp"
 
 namespace toposlam {
 
@@ -114,9 +115,15 @@ bool imageBytesLookComplete(const std::vector<unsigned char>& bytes) {
   return true;  // unknown format: let the decoder decide
 }
 
-ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz, bool rate_given)
-    : origin_(path_or_glob), files_(listImageFiles(path_or_glob)), rate_hz_(timestamp_rate_hz), rate_given_(rate_given) {
+ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz, std::int64_t max_pixels,
+                                   bool rate_given)
+    : origin_(path_or_glob),
+      files_(listImageFiles(path_or_glob)),
+      rate_hz_(timestamp_rate_hz),
+      max_pixels_(max_pixels),
+      rate_given_(rate_given) {
   if (!(rate_hz_ > 0)) throw FrameSourceError("images: rate must be > 0 Hz");
+  if (max_pixels_ < 1) throw FrameSourceError("images: max_pixels must be >= 1");
 }
 
 std::string ImageFilesSource::describe() const {
@@ -130,14 +137,13 @@ std::optional<Frame> ImageFilesSource::next() {
   while (next_index_ < files_.size() && !interrupted_.load()) {
     const std::size_t index = next_index_++;
     const std::string& file = files_[index];
-    std::ifstream in(file, std::ios::binary);
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // One bad file (unreadable, truncated, over the pixel cap, undecodable) is dropped, counted and
+    // named; it never ends the stream.
     cv::Mat image;
-    if (in.bad() || !imageBytesLookComplete(bytes)) {
-      spdlog::warn("images: skipping '{}': unreadable or truncated ({} bytes)", file, bytes.size());
-    } else {
-      image = cv::imdecode(bytes, cv::IMREAD_COLOR);
-      if (image.empty()) spdlog::warn("images: skipping '{}': cannot decode it", file);
+    try {
+      image = readImageFileChecked(file, cv::IMREAD_COLOR, max_pixels_);
+    } catch (const ImageReadError& e) {
+      spdlog::warn("images: skipping {}", e.what());
     }
     if (image.empty()) {
       ++skipped_;

@@ -10,6 +10,7 @@
 #include <condition_variable>
 
 #include "toposlam/io/file_sources.hpp"
+#include "toposlam/io/image_file.hpp"
 #include "toposlam/io/sim_source.hpp"
 
 namespace toposlam {
@@ -84,13 +85,14 @@ class RateLimitedSource : public FrameSource {
 };
 
 std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
-  uri.requireOnly({"fps"});
+  uri.requireOnly({"fps", "max_pixels"});
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': images: needs a folder, file or glob");
   // Frame timestamps (the segmentation window is in seconds): ?fps=HZ, else the real-time ?rate=HZ,
   // else 1 Hz (the bundled keyframes' rate), said in describe() so a user sees the assumption.
   const bool given = uri.has("fps") || uri.has("rate");
   const double hz = uri.has("fps") ? uri.getDouble("fps", 1.0, 1e-3, 1e4) : uri.getDouble("rate", 1.0, 1e-3, 1e4);
-  return std::make_unique<ImageFilesSource>(uri.path, hz, given);
+  return std::make_unique<ImageFilesSource>(uri.path, hz, uri.getInt("max_pixels", kDefaultMaxImagePixels, 1, 1LL << 32),
+                                            given);
 }
 
 std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
@@ -105,7 +107,7 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, SchemeEntry> schemes;
   Registry() {
-    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ][&rate=HZ]"};
+    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ&rate=HZ&max_pixels=N]"};
     schemes["video"] = {openVideo, "video:FILE[?rate=HZ]"};
     schemes["sim"] = {openSim,
                       "sim:WORLD?route=R&fps=F&size=WxH&seed=S[&speed=&fov=&light=day|night|warm|cool&noise=&people=&"

@@ -211,12 +211,111 @@ void jsonNumber(JsonWriter& w, const char* key, float v) {
     w.null();
 }
 
+// ---- array lengths checked before the generated decoder trusts them ------------------------------------
+// The lcm-gen decoders resize every array to its length field before reading the elements, so a
+// negative length (std::length_error) or 10^8 (800 MB) would be allocated from a 100-byte message. This
+// walks the wire format (big-endian, 8-byte type hash first, strings as int32 length incl. NUL + bytes)
+// and refuses a length below 0 or above what the remaining bytes can hold.
+
+struct WireField {
+  enum Kind { Fixed, String, Length, Array } kind;
+  int bytes = 0;                               ///< Fixed: size; Array: element size if fixed (0 = struct)
+  const std::vector<WireField>* element = nullptr;  ///< Array of structs
+};
+
+using WireSchema = std::vector<WireField>;
+WireField fixed(int bytes) { return {WireField::Fixed, bytes, nullptr}; }
+WireField text() { return {WireField::String, 0, nullptr}; }
+WireField length() { return {WireField::Length, 0, nullptr}; }
+WireField array(int element_bytes) { return {WireField::Array, element_bytes, nullptr}; }
+WireField array(const WireSchema& element) { return {WireField::Array, 0, &element}; }
+
+class WireWalker {
+ public:
+  WireWalker(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  bool skip(std::size_t n) {
+    if (n > size_ - pos_) return false;
+    pos_ += n;
+    return true;
+  }
+  bool int32(std::int32_t& v) {
+    if (size_ - pos_ < 4) return false;
+    const std::uint32_t u = (std::uint32_t{data_[pos_]} << 24) | (std::uint32_t{data_[pos_ + 1]} << 16) |
+                            (std::uint32_t{data_[pos_ + 2]} << 8) | std::uint32_t{data_[pos_ + 3]};
+    v = static_cast<std::int32_t>(u);
+    pos_ += 4;
+    return true;
+  }
+  bool walk(const WireSchema& schema) {
+    std::int32_t last_length = 0;
+    for (const WireField& f : schema) {
+      switch (f.kind) {
+        case WireField::Fixed:
+          if (!skip(static_cast<std::size_t>(f.bytes))) return false;
+          break;
+        case WireField::String: {
+          std::int32_t n = 0;
+          // The length counts the terminating NUL, so it is >= 1: the generated decoder assigns len - 1
+          // bytes, and 0 made that a length_error (found by fuzz_lcm_messages).
+          if (!int32(n) || n < 1 || !skip(static_cast<std::size_t>(n))) return false;
+          break;
+        }
+        case WireField::Length:
+          if (!int32(last_length) || last_length < 0) return false;
+          break;
+        case WireField::Array:
+          if (f.element == nullptr) {
+            if (!skip(static_cast<std::size_t>(last_length) * static_cast<std::size_t>(f.bytes))) return false;
+          } else {
+            // Every struct element takes at least one byte, so a length beyond the bytes left is a lie.
+            if (static_cast<std::size_t>(last_length) > size_ - pos_) return false;
+            for (std::int32_t i = 0; i < last_length; ++i)
+              if (!walk(*f.element)) return false;
+          }
+          break;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+};
+
+const WireSchema kPlace = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fixed(8)};
+const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length(), array(1), fixed(8)};
+const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
+const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
+                            length(), array(kStageStatus)};
+const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
+const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopologyNode), length(), array(12)};
+const WireSchema kMotion = {fixed(8 * 7 + 1)};
+
 template <typename Message>
-bool decodeMessage(const lcm::ReceiveBuffer* buffer, Message& msg) {
-  return msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0;
+bool decodeMessage(const lcm::ReceiveBuffer* buffer, Message& msg, const std::string& kind) {
+  if (!lcmArrayLengthsFit(kind, buffer->data, buffer->data_size)) return false;
+  try {
+    return msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0;
+  } catch (const std::exception&) {  // bad_alloc, length_error: survived and counted as malformed
+    return false;
+  }
 }
 
 }  // namespace
+
+bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size) {
+  const WireSchema* schema = kind == "place"         ? &kPlace
+                             : kind == "place_event" ? &kPlaceEvent
+                             : kind == "status"      ? &kStatus
+                             : kind == "topology"    ? &kTopology
+                             : kind == "motion"      ? &kMotion
+                                                     : nullptr;
+  if (schema == nullptr || data == nullptr) return false;
+  WireWalker walker(static_cast<const std::uint8_t*>(data), size);
+  return walker.skip(8) && walker.walk(*schema);  // the type hash, then the fields
+}
 
 struct LcmSubscriber::Route {
   LcmSubscriber* self;
@@ -256,7 +355,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
   bool ok = true;
   if (route->kind == "place") {
     toposlam_lcm::place_t m{};
-    ok = decodeMessage(buffer, m);
+    ok = decodeMessage(buffer, m, route->kind);
     if (ok) {
       out.frame = m.frame;
       out.node = m.node;
@@ -282,7 +381,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
     }
   } else if (route->kind == "place_event") {
     toposlam_lcm::place_event_t m{};
-    ok = decodeMessage(buffer, m);
+    ok = decodeMessage(buffer, m, route->kind);
     if (ok) {
       out.node = m.node;
       out.place = m.place;
@@ -302,7 +401,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
     }
   } else if (route->kind == "topology") {
     toposlam_lcm::topology_t m{};
-    ok = decodeMessage(buffer, m);
+    ok = decodeMessage(buffer, m, route->kind);
     if (ok) {
       out.node = m.current_node;
       w.field("map_revision", m.map_revision).field("probability", m.probability).field("particles", m.particles)
@@ -323,7 +422,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
     }
   } else if (route->kind == "status") {
     toposlam_lcm::status_t m{};
-    ok = decodeMessage(buffer, m);
+    ok = decodeMessage(buffer, m, route->kind);
     if (ok) {
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);
@@ -362,7 +461,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
     }
   } else {
     toposlam_lcm::motion_t m{};
-    ok = decodeMessage(buffer, m);
+    ok = decodeMessage(buffer, m, route->kind);
     if (ok) {
       w.field("utime", m.utime).field("sequence", m.sequence).field("forward_m", m.forward_m)
           .field("turn_rad", m.turn_rad).field("moving", m.moving != 0);

@@ -3,6 +3,7 @@
 #include "toposlam/config/method_preset.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
@@ -202,6 +203,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     map.text("path", c.pipeline.map_path, 4096, true);
     map.flag("load_at_start", c.load_map_at_start);
     map.real("save_period_s", c.pipeline.map_save_period_s, 0, 86400, " seconds (0 = only at stop)");
+    map.real("max_mb", c.map_max_mb, 1, 65536, " MB");
     map.finish();
   }
   {
@@ -335,6 +337,54 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
   top.finish();
 }
 
+// Documents in a YAML text: a "---" line (marker alone or followed by a space) after content, or content
+// after a "..." end line, starts another one. A leading "---" is the first document's optional marker.
+int yamlDocumentCount(const std::string& text) {
+  int documents = 0;
+  bool content = false;  // the current document has a non-comment line
+  bool ended = false;    // a "..." line closed it
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const bool start = line.rfind("---", 0) == 0 && (line.size() == 3 || line[3] == ' ' || line[3] == '\t');
+    const bool end = line.rfind("...", 0) == 0 && (line.size() == 3 || line[3] == ' ' || line[3] == '\t');
+    const std::size_t first = line.find_first_not_of(" \t");
+    const bool blank = first == std::string::npos || line[first] == '#';
+    if (start) {
+      if (content || ended || documents == 0) ++documents;
+      content = line.find_first_not_of(" \t", 3) != std::string::npos && line[line.find_first_not_of(" \t", 3)] != '#';
+      ended = false;
+    } else if (end) {
+      ended = true;
+    } else if (!blank) {
+      if (ended || documents == 0) ++documents;
+      ended = false;
+      content = true;
+    }
+  }
+  return documents;
+}
+
+// yaml-cpp keeps both entries of a repeated key and look-ups see only the first, so the second would be
+// ignored silently: refused, naming the key and its line.
+void refuseDuplicateKeys(const YAML::Node& node, const std::string& path) {
+  if (node.IsSequence()) {
+    for (const YAML::Node& item : node) refuseDuplicateKeys(item, path);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::set<std::string> seen;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string("?");
+    const std::string full = path.empty() ? key : path + "." + key;
+    if (!seen.insert(key).second)
+      throw ConfigError("duplicate key '" + full + "' (line " + std::to_string(entry.first.Mark().line + 1) +
+                        "); give each key once");
+    refuseDuplicateKeys(entry.second, full);
+  }
+}
+
 // Stage validate() messages are "<key>: ..." relative to the stage (fingerprint's are already full).
 std::string prefixed(const std::string& section, const std::string& problem) {
   if (problem.empty() || problem.rfind(section + ".", 0) == 0) return problem;
@@ -350,7 +400,17 @@ DaemonConfig::DaemonConfig() {
 
 std::string DaemonConfig::validate() const {
   if (source.empty()) return "source: must not be empty (e.g. sim:office?route=loop2 or v4l2:/dev/video0)";
+  if (!(map_max_mb >= 1 && map_max_mb <= 65536))
+    return "map.max_mb: " + std::to_string(map_max_mb) + " is out of range, allowed [1, 65536] MB";
   if (lcm.url.empty()) return "lcm.url: must not be empty (e.g. udpm://239.255.76.67:7667?ttl=0)";
+  {
+    // The LCM providers liblcm knows; anything else would only fail when the daemon opens it.
+    static const char* const kProviders[] = {"udpm://", "mpudpm://", "memq://", "file://", "tcpq://"};
+    bool known = false;
+    for (const char* p : kProviders) known = known || lcm.url.rfind(p, 0) == 0;
+    if (!known)
+      return "lcm.url: '" + lcm.url + "' is not an LCM URL, expected udpm://, mpudpm://, memq://, file:// or tcpq://";
+  }
   if (lcm.jpeg_quality < 1 || lcm.jpeg_quality > 100)
     return "lcm.jpeg_quality: " + std::to_string(lcm.jpeg_quality) + " is out of range, allowed 1 .. 100";
   if (fingerprint_workers < 1 || fingerprint_workers > 64)
@@ -382,9 +442,20 @@ std::string DaemonConfig::validate() const {
 DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin) {
   YAML::Node root;
   try {
+    // A second document ("---") would be ignored silently by YAML::Load: refused instead. Found by
+    // scanning the lines, not with YAML::LoadAll, which loops forever on some malformed input in
+    // yaml-cpp 0.7 (found by fuzz_config; tests/fuzz/corpus/config/loadall-hang).
+    if (const int documents = yamlDocumentCount(yaml_text); documents > 1)
+      throw ConfigError(origin + ": holds " + std::to_string(documents) +
+                        " YAML documents (a '---' line starts another); toposlamd reads exactly one");
     root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  try {
+    refuseDuplicateKeys(root, "");
+  } catch (const ConfigError& e) {
+    throw ConfigError(origin + ": " + e.what());
   }
   DaemonConfig config;
   try {
@@ -399,11 +470,21 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
 }
 
 DaemonConfig loadDaemonConfig(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw ConfigError("the config file '" + path + "' is a folder; give the YAML file in it (e.g. " +
+                      (std::filesystem::path(path) / "toposlam.yaml").string() + ")");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError("cannot read the config file '" + path + "' (does it exist and is it readable?)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseDaemonConfig(text.str(), path);
+  // Read at most the cap (+1 to notice more): /dev/zero or a runaway file never reads forever.
+  std::string text(kMaxConfigBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw ConfigError("cannot read the config file '" + path + "'");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxConfigBytes)
+    throw ConfigError("the config file '" + path + "' is larger than " + std::to_string(kMaxConfigBytes >> 10) +
+                      " KiB; is it really a toposlam config?");
+  return parseDaemonConfig(text, path);
 }
 
 }  // namespace toposlam

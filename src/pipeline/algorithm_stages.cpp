@@ -66,8 +66,9 @@ ParticleFilterTopologyStage::ParticleFilterTopologyStage(const TopologyFilterCon
 
 ParticleFilterTopologyStage::~ParticleFilterTopologyStage() = default;
 
-void ParticleFilterTopologyStage::loadMap(const std::string& path) {
-  LoadedMap loaded = MapStore::load(path, similarity_);
+void ParticleFilterTopologyStage::loadMap(const std::string& path) { adoptMap(MapStore::load(path, similarity_)); }
+
+void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   filter_ = std::move(loaded.filter);
   // The application data lists the representative frames of the run that saved the map; frame numbers of
   // an older run mean nothing in this one, so resumed observations show -1.
@@ -162,7 +163,7 @@ std::unique_ptr<const MapSnapshot> ParticleFilterTopologyStage::snapshotMap() co
   std::ostringstream data;
   data << "toposlamd-frames";
   for (std::int64_t f : representative_frames_) data << ' ' << f;
-  return std::make_unique<EncodedMap>(MapStore::encode(*filter_, data.str()));
+  return std::make_unique<EncodedMap>(MapStore::encode(*filter_, data.str(), map_settings_));
 }
 
 }  // namespace toposlam

@@ -189,6 +189,20 @@ bool Pipeline::healthy() const {
   return error().empty();
 }
 
+std::string Pipeline::stalledStages() const {
+  static const char* const kNames[kThreadCount] = {"capture", "fingerprint", "segmentation", "topology", "publisher"};
+  const double now = clock_.now();
+  std::string out;
+  for (int i = 0; i < kThreadCount; ++i) {
+    const double silent = now - heartbeat_[i].load();
+    if (thread_done_[i].load() || waiting_[i].load() || silent <= config_.heartbeat_timeout_s) continue;
+    char item[64];
+    std::snprintf(item, sizeof item, "%s%s %.1f s", out.empty() ? "" : ", ", kNames[i], silent);
+    out += item;
+  }
+  return out;
+}
+
 PipelineStatus Pipeline::status() const {
   std::lock_guard lock(status_mutex_);
   return status_;

@@ -1,17 +1,25 @@
-// MapStore: framing (magic, version, size, FNV-1a checksum) and atomic file replacement for map.tsm.
+// MapStore: framing (magic, version, size, FNV-1a checksum), atomic file replacement, recovery from a
+// damaged file, and the lock of map.tsm.
 #include "toposlam/topology/map_store.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
+#include <istream>
 #include <sstream>
+#include <streambuf>
 #include <vector>
 
 #include "binary_io.hpp"
+#include "toposlam/fingerprint/vpack_extractor.hpp"
 
 namespace toposlam {
 
@@ -33,6 +41,93 @@ struct TempFile {
   }
 };
 
+/// Closes a descriptor on scope exit.
+struct Fd {
+  int fd = -1;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+/// An istream over bytes it does not own (no copy of a large filter state).
+class ViewBuffer : public std::streambuf {
+ public:
+  explicit ViewBuffer(std::string_view data) {
+    char* begin = const_cast<char*>(data.data());  // only read: the get area is never written through
+    setg(begin, begin, begin + data.size());
+  }
+};
+
+/// Reads exactly `size` bytes at the current offset; false on a short read or an error (errno set).
+bool readFully(int fd, char* out, std::size_t size) {
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::read(fd, out + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;  // the file shrank under us
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+/// Opens a regular file for reading and returns its size; throws MapStoreError naming it.
+int openRegular(const std::filesystem::path& path, std::uint64_t& size) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw MapStoreError("cannot open map " + path.string() + ": " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw MapStoreError("cannot read map " + path.string() + ": not a regular file");
+  }
+  size = static_cast<std::uint64_t>(st.st_size);
+  return fd;
+}
+
+std::string sizeText(std::uint64_t bytes) {
+  std::ostringstream out;
+  if (bytes >= (1ull << 20)) {
+    out.precision(1);
+    out << std::fixed << static_cast<double>(bytes) / (1 << 20) << " MB";
+  } else {
+    out << bytes << " bytes";
+  }
+  return out.str();
+}
+
+std::string settingsText(const MapSettings& settings) {
+  std::string text;
+  for (const auto& [key, value] : settings) text += key + "=" + value + "\n";
+  return text;
+}
+
+MapSettings parseSettings(std::string_view text, const std::string& name) {
+  MapSettings settings;
+  while (!text.empty()) {
+    const std::size_t end = text.find('\n');
+    if (end == std::string_view::npos) throw MapStoreError(name + ": damaged map file (unterminated setting)");
+    const std::string_view line = text.substr(0, end);
+    text.remove_prefix(end + 1);
+    const std::size_t eq = line.find('=');
+    if (eq == std::string_view::npos || eq == 0)
+      throw MapStoreError(name + ": damaged map file (bad setting line)");
+    settings[std::string(line.substr(0, eq))] = std::string(line.substr(eq + 1));
+  }
+  return settings;
+}
+
+/// "20240131T120501" in UTC.
+std::string timestampNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%dT%H%M%S", &utc);
+  return text;
+}
+
 }  // namespace
 
 long MapFileOps::write(int fd, const void* data, std::size_t size) const { return ::write(fd, data, size); }
@@ -47,12 +142,18 @@ std::uint64_t fnv1a64(std::string_view data) {
   return hash;
 }
 
-std::string MapStore::encode(const TopologyParticleFilter& filter, std::string_view application_data) {
+MapSettings fingerprintMapSettings(const VpackConfig& config) {
+  return MapSettings{{"keypoints", toString(config.keypoints.backend)}};
+}
+
+std::string MapStore::encode(const TopologyParticleFilter& filter, std::string_view application_data,
+                             const MapSettings& settings) {
   std::ostringstream state;
   filter.saveState(state);
   topology_detail::BinaryWriter payload;
   payload.bytes(state.str());
   payload.bytes(application_data);
+  payload.bytes(settingsText(settings));
   topology_detail::BinaryWriter file;
   for (char c : kMagic) file.u8(static_cast<std::uint8_t>(c));
   file.u32(kMapFormatVersion);
@@ -94,13 +195,16 @@ std::string_view MapStore::verifiedPayload(std::string_view file, const std::str
 LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& similarity,
                            const std::string& name) {
   const std::string_view payload = verifiedPayload(file, name);
+  const std::uint32_t version = topology_detail::BinaryReader(file.substr(8, 4)).u32("version");
   try {
     topology_detail::BinaryReader reader(payload);
     const std::string_view state = reader.bytes("filter state");
     LoadedMap loaded;
     loaded.application_data = std::string(reader.bytes("application data"));
+    if (version >= 2) loaded.settings = parseSettings(reader.bytes("settings"), name);
     if (!reader.atEnd()) throw std::runtime_error("trailing bytes in the payload");
-    std::istringstream state_stream{std::string(state)};
+    ViewBuffer buffer(state);
+    std::istream state_stream(&buffer);
     loaded.filter = TopologyParticleFilter::loadState(state_stream, similarity);
     return loaded;
   } catch (const MapStoreError&) {
@@ -111,19 +215,36 @@ LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& simil
 }
 
 bool MapStore::fileVerifies(const std::filesystem::path& path) {
-  std::error_code ignored;
-  if (!std::filesystem::is_regular_file(path, ignored)) return false;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) return false;
+  // Streamed: a large map is checked in 1 MB pieces, never held in memory here.
+  std::uint64_t file_size = 0;
+  Fd fd;
   try {
-    verifiedPayload(content.str(), path.string());
-    return true;
+    fd.fd = openRegular(path, file_size);
   } catch (const MapStoreError&) {
     return false;
   }
+  if (file_size < kHeaderSize) return false;
+  std::string header(kHeaderSize, '\0');
+  if (!readFully(fd.fd, header.data(), header.size())) return false;
+  if (std::memcmp(header.data(), kMagic, 8) != 0) return false;
+  topology_detail::BinaryReader fields(std::string_view(header).substr(8));
+  const std::uint32_t version = fields.u32("version");
+  fields.u32("reserved");
+  const std::uint64_t size = fields.u64("size");
+  const std::uint64_t checksum = fields.u64("checksum");
+  if (version == 0 || version > kMapFormatVersion || file_size - kHeaderSize != size) return false;
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  std::vector<char> chunk(1 << 20);
+  for (std::uint64_t left = size; left > 0;) {
+    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(left, chunk.size()));
+    if (!readFully(fd.fd, chunk.data(), n)) return false;
+    for (std::size_t i = 0; i < n; ++i) {
+      hash ^= static_cast<std::uint8_t>(chunk[i]);
+      hash *= 0x100000001b3ULL;
+    }
+    left -= n;
+  }
+  return hash == checksum;
 }
 
 void MapStore::writeAtomically(const std::filesystem::path& path, std::string_view bytes,
@@ -198,20 +319,184 @@ void MapStore::save(const std::filesystem::path& path, const TopologyParticleFil
   writeAtomically(path, encode(filter, application_data), ops);
 }
 
-LoadedMap MapStore::load(const std::filesystem::path& path, const SimilarityMeasure& similarity) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw MapStoreError("cannot open map " + path.string() + ": " + errnoText(errno));
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) throw MapStoreError("cannot read map " + path.string());
+void MapStore::save(const std::filesystem::path& path, const TopologyParticleFilter& filter,
+                    std::string_view application_data, const MapSettings& settings, const MapFileOps& ops) {
+  writeAtomically(path, encode(filter, application_data, settings), ops);
+}
+
+LoadedMap MapStore::load(const std::filesystem::path& path, const SimilarityMeasure& similarity,
+                         std::uint64_t max_bytes) {
+  std::uint64_t size = 0;
+  Fd fd;
+  fd.fd = openRegular(path, size);
   std::string hint;
   if (std::filesystem::exists(path.string() + ".prev"))
     hint = " (the previous map is kept in " + path.string() + ".prev)";
+  if (size > max_bytes) {
+    throw MapTooLargeError("map " + path.string() + " is " + sizeText(size) + ", more than the cap of " +
+                           sizeText(max_bytes) + " (map.max_mb); refused unread" + hint);
+  }
+  std::string content(static_cast<std::size_t>(size), '\0');  // read once, into this one buffer
+  if (!readFully(fd.fd, content.data(), content.size()))
+    throw MapStoreError("cannot read map " + path.string() + ": " + std::strerror(errno));
   try {
-    return decode(content.str(), similarity, path.string());
+    return decode(content, similarity, path.string());
   } catch (const MapStoreError& e) {
     throw MapStoreError(e.what() + hint);
   }
+}
+
+std::string MapStore::moveAside(const std::filesystem::path& file) {
+  const std::string stem = file.string() + ".damaged-" + timestampNow();
+  std::string aside = stem;
+  // link() never replaces an existing name, so an earlier .damaged file is never overwritten.
+  int result = -1;
+  int error = 0;
+  for (int n = 1; n <= 100; ++n) {
+    result = ::link(file.c_str(), aside.c_str());
+    error = errno;
+    if (result == 0 || error != EEXIST) break;
+    aside = stem + "-" + std::to_string(n);
+  }
+  if (result != 0) {
+    return "could not move it aside (" + std::string(std::strerror(error)) + "); it is left where it is";
+  }
+  if (::unlink(file.c_str()) != 0) {
+    const int unlink_error = errno;
+    ::unlink(aside.c_str());
+    return "could not move it aside (" + std::string(std::strerror(unlink_error)) + "); it is left where it is";
+  }
+  // Keep the newest kMaxDamagedFiles of this file (names sort by their timestamps).
+  std::vector<std::filesystem::path> damaged;
+  std::error_code ec;
+  const std::filesystem::path directory =
+      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  const std::string prefix = file.filename().string() + ".damaged-";
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) == 0) damaged.push_back(entry.path());
+  }
+  std::sort(damaged.begin(), damaged.end());  // oldest first: "<ts>" < "<ts>-1" < "<later ts>"
+  std::string pruned;
+  while (damaged.size() > static_cast<std::size_t>(kMaxDamagedFiles)) {
+    std::filesystem::remove(damaged.front(), ec);
+    pruned += (pruned.empty() ? "" : ", ") + damaged.front().filename().string();
+    damaged.erase(damaged.begin());
+  }
+  std::string text = "moved it to " + aside;
+  if (!pruned.empty()) text += " (removed the oldest damaged copies: " + pruned + ")";
+  return text;
+}
+
+RecoveredMap MapStore::recover(const std::filesystem::path& path, const SimilarityMeasure& similarity,
+                               std::uint64_t max_bytes) {
+  RecoveredMap result;
+  const std::filesystem::path candidates[] = {path, std::filesystem::path(path.string() + ".prev")};
+  for (const std::filesystem::path& candidate : candidates) {
+    std::error_code ec;
+    if (!std::filesystem::exists(candidate, ec)) continue;
+    try {
+      result.map = load(candidate, similarity, max_bytes);
+      result.loaded_from = candidate;
+      return result;
+    } catch (const MapTooLargeError&) {
+      throw;  // not damage: nothing is moved, the caller refuses to start (a bigger cap, or another map)
+    } catch (const MapStoreError& e) {
+      result.problems.push_back(std::string(e.what()) + "; " + moveAside(candidate));
+    }
+  }
+  return result;
+}
+
+std::string MapStore::checkSettings(const MapSettings& recorded, const MapSettings& current,
+                                    const std::string& name) {
+  std::string recorded_text, current_text;
+  for (const auto& [key, value] : recorded) {
+    const auto found = current.find(key);
+    if (found == current.end() || found->second == value) continue;
+    recorded_text += (recorded_text.empty() ? "" : ", ") + key + "=" + value;
+    current_text += (current_text.empty() ? "" : ", ") + key + "=" + found->second;
+  }
+  if (recorded_text.empty()) return {};
+  return "the map " + name + " was made with " + recorded_text + " but this run uses " + current_text +
+         ": continue it with the same settings, or start a new map";
+}
+
+int MapStore::removeOrphanedTemporaries(const std::filesystem::path& path) {
+  const std::filesystem::path directory =
+      path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  const std::string prefix = "." + path.filename().string() + ".";
+  int removed = 0;
+  std::error_code ec;
+  std::vector<std::filesystem::path> orphans;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
+    std::string rest = entry.path().filename().string();
+    if (rest.rfind(prefix, 0) != 0) continue;
+    rest = rest.substr(prefix.size());
+    if (rest.size() == 6 + 5 && rest.compare(6, 5, ".prev") == 0) rest.resize(6);
+    // mkstemp's six characters: letters and digits.
+    if (rest.size() == 6 && std::all_of(rest.begin(), rest.end(), [](char c) {
+          return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+        }))
+      orphans.push_back(entry.path());
+  }
+  for (const auto& orphan : orphans)
+    if (std::filesystem::remove(orphan, ec)) ++removed;
+  return removed;
+}
+
+// ------------------------------------------------------------------------------------------------------------
+
+MapLock MapLock::acquire(const std::filesystem::path& map_path) {
+  std::filesystem::path locked = map_path.string() + ".lock";
+  int fd = ::open(locked.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0 && (errno == EROFS || errno == EACCES || errno == EPERM)) {
+    // A read-only state directory: lock the directory itself (saves will fail there anyway, but a second
+    // daemon is still refused).
+    locked = map_path.has_parent_path() ? map_path.parent_path() : std::filesystem::path(".");
+    fd = ::open(locked.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  }
+  if (fd < 0) throw MapStoreError("cannot create the lock file " + locked.string() + ": " + std::strerror(errno));
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    std::string holder;
+    char text[32] = {};
+    if (::pread(fd, text, sizeof text - 1, 0) > 0) {
+      const long pid = std::strtol(text, nullptr, 10);
+      if (pid > 0) holder = " (process " + std::to_string(pid) + ")";
+    }
+    ::close(fd);
+    if (error == EWOULDBLOCK) {
+      throw MapStoreError("the map " + map_path.string() + " is in use by another toposlam process" + holder +
+                          ": it holds " + locked.string() + "; stop it or use another map path");
+    }
+    throw MapStoreError("cannot lock " + locked.string() + ": " + std::strerror(error));
+  }
+  // Record our process id for the message a second process prints (best effort).
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd, 0) == 0 && ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
+      // ignored: the lock itself is what matters
+    }
+  }
+  return MapLock(fd, locked);
+}
+
+MapLock::MapLock(MapLock&& other) noexcept : fd_(other.fd_), locked_(std::move(other.locked_)) { other.fd_ = -1; }
+
+MapLock& MapLock::operator=(MapLock&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = other.fd_;
+    locked_ = std::move(other.locked_);
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+MapLock::~MapLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing the last descriptor releases the flock
 }
 
 }  // namespace toposlam

@@ -40,6 +40,7 @@ SCENARIO("The shipped config documents the defaults in code") {
       CHECK(shipped.lcm.jpeg_quality == defaults.lcm.jpeg_quality);
       CHECK(shipped.pipeline.map_path == defaults.pipeline.map_path);
       CHECK(shipped.pipeline.map_save_period_s == defaults.pipeline.map_save_period_s);
+      CHECK(shipped.map_max_mb == defaults.map_max_mb);
       CHECK(shipped.load_map_at_start == defaults.load_map_at_start);
       CHECK(shipped.watchdog == defaults.watchdog);
       CHECK(shipped.pipeline.heartbeat_timeout_s == defaults.pipeline.heartbeat_timeout_s);
@@ -200,6 +201,25 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
 SCENARIO("A config file that cannot be read is refused with its path") {
   CHECK_THROWS_WITH(loadDaemonConfig("/nonexistent/toposlam.yaml"),
                     Catch::Contains("cannot read the config file '/nonexistent/toposlam.yaml'"));
+}
+
+SCENARIO("A folder, an endless file, a repeated key or a second document is refused, not read as defaults") {
+  CHECK_THROWS_WITH(loadDaemonConfig(TOPOSLAM_SOURCE_DIR "/config"),
+                    Catch::Contains("is a folder") && Catch::Contains("config/toposlam.yaml"));
+  CHECK_THROWS_WITH(loadDaemonConfig("/dev/zero"), Catch::Contains("'/dev/zero' is larger than 1024 KiB"));
+  CHECK_THAT(errorOf("map:\n  path: a.tsm\n  path: b.tsm\n"),
+             Catch::Contains("duplicate key 'map.path' (line 3)"));
+  CHECK_THAT(errorOf("source: images:a\nsource: images:b\n"), Catch::Contains("duplicate key 'source' (line 2)"));
+  CHECK_THAT(errorOf("source: images:a\n---\nsource: images:b\n"),
+             Catch::Contains("holds 2 YAML documents") && Catch::StartsWith("test.yaml"));
+  CHECK(errorOf("").empty());
+  CHECK(errorOf("---\nsource: images:a\n").empty());
+  CHECK(errorOf("source: images:a\n...\n").empty());
+  // yaml-cpp 0.7's LoadAll loops forever on this (found by fuzz_config); YAML::Load returns at once.
+  CHECK_NOTHROW(errorOf(",iQSLAM_MOar"));
+  CHECK_THAT(errorOf("map:\n  max_mb: 0\n"), Catch::Contains("map.max_mb"));
+  CHECK_THAT(errorOf("lcm:\n  url: udp-multicast-please\n"), Catch::Contains("lcm.url: 'udp-multicast-please' is not an LCM URL"));
+  CHECK(errorOf("lcm:\n  url: memq://\n").empty());
 }
 
 SCENARIO("DaemonConfig::validate() names keys by their YAML path") {

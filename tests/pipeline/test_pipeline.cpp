@@ -358,8 +358,12 @@ SCENARIO("GIVEN a source hung inside next() THEN the pipeline is unhealthy (stal
   pipeline.start();
   source.waitForCalls(1);
   CHECK(pipeline.healthy());
+  CHECK(pipeline.stalledStages().empty());
   clock.advance(6.0);
   CHECK_FALSE(pipeline.healthy());  // the capture thread has been inside the source for 6 s > 5 s
+  // What toposlamd's STATUS= names. (The topology thread may be caught between two waits, so it can be
+  // listed too; the capture thread is always there.)
+  CHECK_THAT(pipeline.stalledStages(), Catch::StartsWith("capture 6.0 s"));
   THEN("requestStop() interrupts the source: the threads end and the map is saved once") {
     REQUIRE(stopsWithin(pipeline, source, std::chrono::seconds(10)));
     CHECK(pipeline.finished());

@@ -41,6 +41,7 @@ struct DaemonConfig {
   std::string source = "sim:office?route=loop2";
   LcmSettings lcm;
   bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
+  double map_max_mb = 256;        ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
   bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
   PipelineConfig pipeline;        ///< queues, threads, budgets; map.path and map.save_period_s land here
   int fingerprint_workers = 2;    ///< fingerprint.workers: WorkerPool size incl. the fingerprint thread
@@ -59,7 +60,10 @@ struct DaemonConfig {
 /// Parses YAML text onto the defaults. `origin` names the text in messages (a file name).
 /// Throws ConfigError on syntax errors, unknown keys, wrong types and out-of-range values.
 DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin = "config");
-/// Reads and parses a file; ConfigError if it cannot be read.
+/// A config file larger than this is refused (bytes).
+inline constexpr std::size_t kMaxConfigBytes = 1 << 20;
+/// Reads and parses a file; ConfigError if it cannot be read, is a folder or is over kMaxConfigBytes.
+/// A repeated key or a second YAML document is refused (parseDaemonConfig).
 DaemonConfig loadDaemonConfig(const std::string& path);
 
 }  // namespace toposlam

@@ -13,6 +13,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "toposlam/io/frame_source.hpp"
+#include "toposlam/io/image_file.hpp"
 
 namespace toposlam {
 
@@ -29,9 +30,11 @@ bool imageBytesLookComplete(const std::vector<unsigned char>& bytes);
 
 class ImageFilesSource : public FrameSource {
  public:
-  /// timestamps are file index / timestamp_rate_hz (the bundled samples are ~1 Hz keyframes).
-  /// rate_given = false: the rate is an assumption, and describe() says so.
-  ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0, bool rate_given = true);
+  /// timestamps are file index / timestamp_rate_hz (the bundled samples are ~1 Hz keyframes). A file whose
+  /// header claims more than max_pixels pixels is skipped undecoded (image_file.hpp). rate_given = false:
+  /// the rate is an assumption, and describe() says so.
+  ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0,
+                   std::int64_t max_pixels = kDefaultMaxImagePixels, bool rate_given = true);
   std::string describe() const override;
   std::optional<Frame> next() override;
   void interrupt() override { interrupted_.store(true); }
@@ -43,6 +46,7 @@ class ImageFilesSource : public FrameSource {
   std::string origin_;
   std::vector<std::string> files_;
   double rate_hz_;
+  std::int64_t max_pixels_;
   bool rate_given_ = true;
   std::size_t next_index_ = 0;
   std::int64_t skipped_ = 0;

@@ -15,6 +15,7 @@
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/stages.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/topology/map_store.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -66,6 +67,10 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   /// Replaces the filter by the map saved at `path`. Throws MapStoreError (with the reason) if it is not
   /// a valid map.
   void loadMap(const std::string& path);
+  /// Replaces the filter by a map already loaded (e.g. by MapStore::recover).
+  void adoptMap(LoadedMap loaded);
+  /// The settings recorded in every map snapshot (MapStore::checkSettings compares them on resume).
+  void setMapSettings(MapSettings settings) { map_settings_ = std::move(settings); }
 
   void enqueuePlace(const ClosedPlace& place) override;
   std::optional<PlaceAssignment> advance(double budget_s) override;
@@ -90,6 +95,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   std::int64_t revision_ = 0;
   PlaceEstimate estimate_;
   TopologySnapshot topology_;
+  MapSettings map_settings_;
 };
 
 }  // namespace toposlam

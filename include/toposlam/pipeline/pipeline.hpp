@@ -103,6 +103,10 @@ class Pipeline {
   /// False when a running stage thread has been inside its work (not waiting for input or a frame) for
   /// heartbeat_timeout_s, or a stage failed (watchdog food). A camera away or silent is healthy.
   bool healthy() const;
+  /// The stage threads that make healthy() false by being inside their work for too long, as
+  /// "capture 6.0 s, topology 7.5 s" (seconds since their last heartbeat); "" when none. The daemon puts
+  /// it in its STATUS= so a stall that withholds the watchdog pings says where it is.
+  std::string stalledStages() const;
   /// The last status published (updated every status period by the publisher thread).
   PipelineStatus status() const;
   /// Every frame's capture-to-publish latency in ms, in publish order (record_latencies only; after wait()).

@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "commands.hpp"
+#include "toposlam/core/output_file.hpp"
 #include "image_input.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -89,13 +90,12 @@ LabelledImageList readListReporting(const std::string& csv, int& problems) {
 }
 
 void writePredictions(const std::string& path, const std::vector<Prediction>& predictions) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write the predictions file");
+  OutputFile out(path);  // temporary name, checked, renamed: a full disk is an error naming the file
   out << "image,expected,label,probability,correct\n";
   for (const Prediction& p : predictions)
     out << quoteCsvField(p.image) << "," << quoteCsvField(p.expected) << "," << quoteCsvField(p.predicted) << "," << std::fixed << std::setprecision(6)
         << p.probability << "," << (p.correct ? 1 : 0) << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
+  out.commit();
 }
 
 void runLocalize(const LocalizeOptions& o) {

@@ -140,6 +140,10 @@ void runMap(const MapOptions& o, bool filter_options_given) {
           "when resuming; drop them or start a new map");
     }
     LoadedMap loaded = MapStore::load(o.resume, similarity);
+    // ORB descriptors mean nothing to a SIFT run (and so on): the map says what it was made with.
+    if (const std::string refusal = MapStore::checkSettings(loaded.settings, fingerprintMapSettings(vpack), o.resume);
+        !refusal.empty())
+      throw std::invalid_argument("map: " + refusal + " (--keypoints)");
     filter = std::move(loaded.filter);
     origins = decodeOrigins(loaded.application_data, filter->observationCount());
     for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
@@ -221,8 +225,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const std::vector<int>& assignment = final_estimate.best.assignment;
   const std::vector<std::int64_t> place_nodes = mapper.placeNodes();
   {
-    std::ofstream out = openOutput(out_dir / "source.txt");
+    OutputFile out = openOutput(out_dir / "source.txt");
     for (const std::string& uri : o.sources) out << absoluteSourceUri(uri) << "\n";
+    out.commit();
   }
   // Frame-level loop closures (docs/topology.md): each frame on a node seen on an earlier visit gets that
   // visit's most similar frame, scored by similarity x the place's node probability at its step.
@@ -245,22 +250,26 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   }
   frame_fingerprints.clear();
   {
-    std::ofstream out = openOutput(out_dir / "frames.csv");
+    OutputFile out = openOutput(out_dir / "frames.csv");
     writeFramesCsv(out, all, place_nodes, &loop);
+    out.commit();
   }
   {
-    std::ofstream out = openOutput(out_dir / "places.csv");
+    OutputFile out = openOutput(out_dir / "places.csv");
     writePlacesCsv(out, all.places, place_nodes);
+    out.commit();
   }
   {
-    std::ofstream out = openOutput(out_dir / "dropped_places.csv");
+    OutputFile out = openOutput(out_dir / "dropped_places.csv");
     writePlacesCsv(out, all.dropped_places);
+    out.commit();
   }
   writeTimingCsv(out_dir / "timing.csv", timing);
   {
-    std::ofstream out = openOutput(out_dir / "lambda2.svg");
+    OutputFile out = openOutput(out_dir / "lambda2.svg");
     out << renderSvgLinePlot(lambda2Plot(
         all, segmenter_config, "Fiedler value over " + std::to_string(o.sources.size()) + " source(s)"));
+    out.commit();
   }
 
   // Nodes and edges of the best topology (over all observations, resumed ones included).
@@ -283,7 +292,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (assignment[k] != assignment[k - 1]) ++edges[{assignment[k - 1], assignment[k]}];
   }
   {
-    std::ofstream out = openOutput(out_dir / "topology.json");
+    OutputFile out = openOutput(out_dir / "topology.json");
     JsonWriter json(out);
     json.beginObject();
     json.field("probability", final_estimate.best.probability);
@@ -334,6 +343,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     json.endArray();
     json.endObject();
     out << "\n";
+    out.commit();
   }
   {
     std::ostringstream dot;
@@ -351,8 +361,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     }
     dot << "}\n";
     {
-      std::ofstream out = openOutput(out_dir / "topology.dot");
+      OutputFile out = openOutput(out_dir / "topology.dot");
       out << dot.str();
+      out.commit();
     }
     if (std::system("command -v dot >/dev/null 2>&1") == 0) {
       const std::string dot_path = shellQuote((out_dir / "topology.dot").string());
@@ -365,7 +376,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
     }
   }
-  MapStore::save(out_dir / "map.tsm", *filter, encodeOrigins(origins));
+  MapStore::save(out_dir / "map.tsm", *filter, encodeOrigins(origins), fingerprintMapSettings(vpack));
 
   std::printf(
       "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "

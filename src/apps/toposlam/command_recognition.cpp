@@ -23,6 +23,7 @@
 #include "commands.hpp"
 #include "image_input.hpp"
 #include "toposlam/core/json_writer.hpp"
+#include "toposlam/core/output_file.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/eval/evaluation.hpp"
 #include "toposlam/eval/orb_baseline.hpp"
@@ -169,7 +170,7 @@ void fillMatrix(const eval::RecognitionTruth& truth, MethodResult& result, Score
 }
 
 void writeMatrixCsv(const std::string& path, const MethodResult& m, const eval::RecognitionTruth& truth) {
-  std::ofstream out(path);
+  OutputFile out(path);
   out << "query,reference,similarity,truth\n";
   for (int q = 0; q < truth.queries; ++q)
     for (int r = 0; r < truth.references; ++r) {
@@ -179,8 +180,7 @@ void writeMatrixCsv(const std::string& path, const MethodResult& m, const eval::
           << m.similarity[static_cast<std::size_t>(q) * static_cast<std::size_t>(truth.references) + static_cast<std::size_t>(r)]
           << "," << static_cast<int>(s) << "\n";
     }
-  out.flush();
-  if (!out) throw std::runtime_error(path + ": write failed");
+  out.commit();
 }
 
 // Heat map: similarity scaled to the largest candidate value, non-candidates black, true matches framed
@@ -230,10 +230,7 @@ void writePrSvg(const std::string& path, const std::vector<MethodResult>& method
     }
     plot.series.push_back(std::move(s));
   }
-  std::ofstream out(path);
-  out << renderSvgLinePlot(plot);
-  out.flush();
-  if (!out) throw std::runtime_error(path + ": write failed");
+  writeFileAtomically(path, renderSvgLinePlot(plot));
 }
 
 std::string fixed3(double v) {
@@ -350,10 +347,9 @@ void runRecognition(const RecognitionOptions& o) {
     stream << "\n";
   };
   if (!o.out.empty()) {
-    std::ofstream out(o.out + "/recognition.json");
+    OutputFile out(o.out + "/recognition.json");
     writeJson(out);
-    out.flush();
-    if (!out) throw std::runtime_error(o.out + "/recognition.json: write failed");
+    out.commit();
   }
   if (o.json) {
     writeJson(std::cout);

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
+#include "toposlam/core/output_file.hpp"
 #include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"
@@ -161,17 +162,11 @@ void runReport(const ReportCommandOptions& o) {
   }
 
   const fs::path out = o.out.empty() ? fs::path(o.run_dir) / "report.html" : fs::path(o.out);
-  std::ofstream html(out, std::ios::binary);
-  if (!html) throw std::runtime_error(out.string() + ": cannot write the report");
-  html << eval::renderReportHtml(in);
-  html.close();
-  if (!html) throw std::runtime_error(out.string() + ": error while writing");
+  writeFileAtomically(out, eval::renderReportHtml(in));  // temporary name, checked, renamed
   if (!o.figures.empty()) {
     fs::create_directories(o.figures);
     for (const auto& [name, svg] : eval::renderReportFigures(in)) {
-      std::ofstream file(fs::path(o.figures) / name, std::ios::binary);
-      file << svg;
-      if (!file) throw std::runtime_error(o.figures + "/" + name + ": cannot write");
+      writeFileAtomically(fs::path(o.figures) / name, svg);
     }
     std::cout << "wrote the figures as SVG files into " << o.figures << "\n";
   }

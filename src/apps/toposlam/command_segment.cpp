@@ -97,25 +97,30 @@ void runSegment(const SegmentOptions& o) {
   }
   const std::filesystem::path dir(o.out);
   {
-    std::ofstream out = openOutput(dir / "source.txt");
+    OutputFile out = openOutput(dir / "source.txt");
     out << absoluteSourceUri(o.source) << "\n";
+    out.commit();
   }
   {
-    std::ofstream out = openOutput(dir / "frames.csv");
+    OutputFile out = openOutput(dir / "frames.csv");
     writeFramesCsv(out, run);
+    out.commit();
   }
   {
-    std::ofstream out = openOutput(dir / "places.csv");
+    OutputFile out = openOutput(dir / "places.csv");
     writePlacesCsv(out, run.places);
+    out.commit();
   }
   {
-    std::ofstream out = openOutput(dir / "dropped_places.csv");
+    OutputFile out = openOutput(dir / "dropped_places.csv");
     writePlacesCsv(out, run.dropped_places);
+    out.commit();
   }
   writeTimingCsv(dir / "timing.csv", timing);
   {
-    std::ofstream out = openOutput(dir / "lambda2.svg");
+    OutputFile out = openOutput(dir / "lambda2.svg");
     out << renderSvgLinePlot(lambda2Plot(run, config, "Fiedler value over " + o.source));
+    out.commit();
   }
 
   const TimingSummary f = summarize(fingerprint_ms);

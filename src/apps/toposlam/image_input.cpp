@@ -9,17 +9,14 @@
 #include <opencv2/imgproc.hpp>
 
 #include "toposlam/core/natural_order.hpp"
+#include "toposlam/io/image_file.hpp"
 
 namespace toposlam::cli {
 
 cv::Mat readImageFile(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw std::runtime_error(path + ": no such file");
-  if (std::filesystem::is_directory(path, error)) throw std::runtime_error(path + ": is a folder, not an image");
-  // ANYCOLOR without ANYDEPTH: 8-bit, grey kept as one channel, colour as BGR (alpha dropped).
-  cv::Mat image = cv::imread(path, cv::IMREAD_ANYCOLOR);
-  if (image.empty()) throw std::runtime_error(path + ": not a readable image (corrupt or unsupported format)");
-  return image;
+  // ANYCOLOR without ANYDEPTH: 8-bit, grey kept as one channel, colour as BGR (alpha dropped). A truncated
+  // file (a JPEG without its end marker) or one over the pixel cap is refused, not decoded half grey.
+  return readImageFileChecked(path, cv::IMREAD_ANYCOLOR);
 }
 
 Fingerprint fingerprintImage(const VpackExtractor& extractor, const cv::Mat& image, const std::string& path) {

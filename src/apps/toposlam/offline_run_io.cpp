@@ -21,11 +21,7 @@ std::unique_ptr<FrameSource> openSource(const std::string& uri) {
 #endif
 }
 
-std::ofstream openOutput(const std::filesystem::path& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw std::runtime_error(path.string() + ": cannot create file (is the folder writable?)");
-  return out;
-}
+OutputFile openOutput(const std::filesystem::path& path) { return OutputFile(path); }
 
 void createRunFolder(const std::string& dir) {
   std::error_code error;
@@ -37,7 +33,7 @@ void createRunFolder(const std::string& dir) {
 }
 
 void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTiming>& rows) {
-  std::ofstream out = openOutput(path);
+  OutputFile out = openOutput(path);
   out << "frame,fingerprint_ms,segment_ms,filter_ms\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     char line[112];
@@ -49,6 +45,7 @@ void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTi
     }
     out << '\n';
   }
+  out.commit();
 }
 
 namespace {

@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "toposlam/config/method_preset.hpp"
+#include "toposlam/core/output_file.hpp"
 #include "toposlam/io/frame_source.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 
@@ -22,8 +23,10 @@ namespace toposlam::cli {
 /// Opens a source URI (images:, video:, sim:, ...); throws FrameSourceError when it cannot.
 std::unique_ptr<FrameSource> openSource(const std::string& uri);
 
-/// Creates (truncates) `path`; throws std::runtime_error naming it when it cannot.
-std::ofstream openOutput(const std::filesystem::path& path);
+/// An output file of the run folder (core/output_file.hpp): written under a temporary name; call
+/// commit() when done, which checks every write and renames it over `path`. Throws OutputFileError
+/// naming the file (cannot create it, a full disk, ...). Not committed: nothing is written.
+OutputFile openOutput(const std::filesystem::path& path);
 
 /// Creates the run folder; throws std::runtime_error naming it when it cannot.
 void createRunFolder(const std::string& dir);

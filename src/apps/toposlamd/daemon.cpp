@@ -1,6 +1,11 @@
-// toposlamd's body; see daemon.hpp. Signals: SIGTERM/SIGINT/SIGHUP are blocked in every thread (the mask is
-// set before any thread exists, threads inherit it) and taken synchronously by the main thread with
-// sigtimedwait(), so no work happens in a signal handler.
+// toposlamd's body; see daemon.hpp. Signals are blocked in every thread (the mask is set before any thread
+// exists, threads inherit it) and taken synchronously by the main thread with sigtimedwait(), so no work
+// happens in a signal handler:
+//   SIGTERM, SIGINT, SIGHUP, SIGQUIT   finish the filter step in progress, save the map, exit 0
+//   SIGUSR1, SIGUSR2, SIGALRM          logged and otherwise ignored (their default would kill the daemon
+//                                      without a final save)
+//   SIGPIPE                            ignored: a write to a closed pipe (a log reader gone) fails with
+//                                      EPIPE, which the writers treat as a failed write, not as the end
 #include "daemon.hpp"
 
 #include <signal.h>
@@ -10,10 +15,13 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <iterator>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -32,12 +40,19 @@ namespace toposlam::daemon {
 
 namespace {
 
-sigset_t stopSignals() {
+constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT};
+constexpr int kIgnoredSignals[] = {SIGUSR1, SIGUSR2, SIGALRM};
+
+bool isStopSignal(int signal) {
+  return std::find(std::begin(kStopSignals), std::end(kStopSignals), signal) != std::end(kStopSignals);
+}
+
+/// Every signal the main thread takes with sigtimedwait (stop and ignored ones).
+sigset_t handledSignals() {
   sigset_t set;
   sigemptyset(&set);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGHUP);
+  for (int s : kStopSignals) sigaddset(&set, s);
+  for (int s : kIgnoredSignals) sigaddset(&set, s);
   return set;
 }
 
@@ -96,8 +111,9 @@ std::string resolveMapPath(const std::string& path) {
 }
 
 int runDaemon(const DaemonConfig& config) {
-  const sigset_t signals = stopSignals();
+  const sigset_t signals = handledSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // before any thread exists: all inherit it
+  std::signal(SIGPIPE, SIG_IGN);                  // EPIPE instead of death on a closed log pipe
 
   SystemdNotifier notifier;
   SteadyClock clock;
@@ -107,18 +123,33 @@ int runDaemon(const DaemonConfig& config) {
   Assembly parts(config, clock, config.source);
   spdlog::info("toposlamd: source {}", parts.source->describe());
 
-  if (config.load_map_at_start && !pipeline_config.map_path.empty() &&
-      std::filesystem::exists(pipeline_config.map_path)) {
-    try {
-      parts.topology->loadMap(pipeline_config.map_path);
-      spdlog::info("toposlamd: resumed the map {} ({} places)", pipeline_config.map_path, parts.topology->observations());
-    } catch (const std::exception& e) {
-      // A damaged map must not keep the robot from starting: keep it aside for a human, start afresh.
-      const std::string aside = pipeline_config.map_path + ".damaged";
-      std::error_code ec;
-      std::filesystem::rename(pipeline_config.map_path, aside, ec);
-      spdlog::error("toposlamd: cannot load the map {} ({}); moved it to {} and starting a new map",
-                    pipeline_config.map_path, e.what(), aside);
+  // One writer per map: a second daemon (or `toposlam map`) on the same file is refused here, before
+  // anything is loaded or saved. Then the temporary files of saves a kill -9 interrupted are removed.
+  std::optional<MapLock> map_lock;
+  if (!pipeline_config.map_path.empty()) {
+    map_lock = MapLock::acquire(pipeline_config.map_path);
+    if (const int orphans = MapStore::removeOrphanedTemporaries(pipeline_config.map_path); orphans > 0)
+      spdlog::info("toposlamd: removed {} temporary file(s) of interrupted map saves beside {}", orphans,
+                   pipeline_config.map_path);
+  }
+  const MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
+  parts.topology->setMapSettings(map_settings);
+  if (config.load_map_at_start && !pipeline_config.map_path.empty()) {
+    // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
+    // human under a timestamped name (never over an earlier one) and the robot starts from what is left.
+    const auto max_bytes = static_cast<std::uint64_t>(config.map_max_mb * 1024.0 * 1024.0);
+    RecoveredMap recovered = MapStore::recover(pipeline_config.map_path, *parts.similarity, max_bytes);
+    for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
+    if (recovered.map) {
+      const std::string refusal =
+          MapStore::checkSettings(recovered.map->settings, map_settings, recovered.loaded_from.string());
+      if (!refusal.empty()) throw MapStoreError(refusal);
+      parts.topology->adoptMap(std::move(*recovered.map));
+      spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
+                   parts.topology->observations(),
+                   recovered.problems.empty() ? "" : ", the newest file that loads");
+    } else if (!recovered.problems.empty()) {
+      spdlog::error("toposlamd: no map file of {} loads; starting a new map", pipeline_config.map_path);
     }
   }
 
@@ -149,7 +180,9 @@ int runDaemon(const DaemonConfig& config) {
   while (!pipeline.finished()) {
     // Once stopping, look for the end more often so the exit follows the map save closely.
     const int signal = waitForSignal(signals, stopping ? std::min(tick_s, 0.1) : tick_s);
-    if (signal != 0 && !stopping) {
+    if (signal != 0 && !isStopSignal(signal)) {
+      spdlog::info("toposlamd: {} received: ignored (stop with SIGTERM, SIGINT, SIGHUP or SIGQUIT)", strsignal(signal));
+    } else if (signal != 0 && !stopping) {
       stopping = true;
       spdlog::info("toposlamd: {} received: finishing the filter step in progress and saving the map",
                    strsignal(signal));
@@ -158,7 +191,14 @@ int runDaemon(const DaemonConfig& config) {
       pipeline.requestStop();
     }
     if (watchdog_s > 0 && pipeline.healthy()) notifier.watchdog();
-    if (!stopping) notifier.status(statusLine(pipeline.status()));  // says when the camera is reconnecting
+    if (!stopping) {
+      // Says when the camera is reconnecting; a stalled stage (no heartbeat while inside its work) is named,
+      // since that is also why the watchdog pings stop.
+      const std::string stalled = pipeline.stalledStages();
+      notifier.status(stalled.empty() ? statusLine(pipeline.status())
+                                      : "stalled: " + stalled + " without progress (watchdog pings withheld); " +
+                                            statusLine(pipeline.status()));
+    }
   }
   pipeline.wait();
   receiving.store(false);

@@ -1,6 +1,7 @@
 // toposlamd: the real-time topological SLAM service. Reads one config (default
 // $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
 // runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
+#include <csignal>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
+#include "sources.hpp"
 #include "toposlam/config/daemon_config.hpp"
 
 namespace {
@@ -39,6 +41,8 @@ std::string defaultConfigPath() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
   app.set_version_flag("--version", "toposlamd 0.1.0");
   std::string config_path;
@@ -49,7 +53,8 @@ int main(int argc, char** argv) {
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
                                                  defaultConfigPath() + " if it exists, else built-in defaults");
   app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
-  app.add_option("--map", map_path, "override `map.path` (relative paths resolve against $STATE_DIRECTORY)");
+  auto* map_option = app.add_option("--map", map_path,
+                                    "override `map.path` (relative paths resolve against $STATE_DIRECTORY; \"\" = never saved)");
   app.add_option("--lcm-url", lcm_url, "override `lcm.url`");
   app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
   app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
@@ -69,7 +74,7 @@ int main(int argc, char** argv) {
       config_path = "(built-in defaults)";
     }
     if (!source.empty()) config.source = source;
-    if (!map_path.empty()) config.pipeline.map_path = map_path;
+    if (map_option->count() > 0) config.pipeline.map_path = map_path;  // --map "" means no map file
     if (!lcm_url.empty()) config.lcm.url = lcm_url;
     if (overflow == "block") config.pipeline.queues.overflow = toposlam::QueueOverflow::Block;
     if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
@@ -78,6 +83,8 @@ int main(int argc, char** argv) {
     if (std::string problem = config.validate(); !problem.empty())
       throw toposlam::ConfigError("command line: " + problem);
     if (check_only) {
+      if (const std::string problem = toposlam::daemon::checkSourceUri(config.source); !problem.empty())
+        throw toposlam::ConfigError(config_path + ": source: " + problem);
       std::cout << "toposlamd: config OK: " << config_path << "\n";
       return 0;
     }

@@ -3,10 +3,12 @@
 // reconnecting (status "camera reconnecting") and opens the camera when it appears (URI wait=0 opts out).
 #include "sources.hpp"
 
+#include <filesystem>
 #include <mutex>
 
 #ifdef TOPOSLAM_HAVE_SOURCES
 #include "toposlam/io/source_factory.hpp"
+#include "toposlam/io/source_uri.hpp"
 #endif
 #ifdef TOPOSLAM_HAVE_V4L2
 #include "toposlam/io/v4l2_frame_source.hpp"
@@ -17,8 +19,9 @@
 
 namespace toposlam::daemon {
 
-std::unique_ptr<FrameSource> openSource(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
+namespace {
+
+void registerCameraSchemes() {
   static std::once_flag registered;
   std::call_once(registered, [] {
 #ifdef TOPOSLAM_HAVE_V4L2
@@ -28,6 +31,38 @@ std::unique_ptr<FrameSource> openSource(const std::string& uri) {
     registerLibcameraFrameSourceScheme();
 #endif
   });
+}
+
+}  // namespace
+
+std::string checkSourceUri(const std::string& uri) {
+#ifdef TOPOSLAM_HAVE_SOURCES
+  registerCameraSchemes();
+  try {
+    const SourceUri parsed = parseSourceUri(uri);
+    if (parsed.scheme.empty()) {
+      std::error_code error;
+      if (!std::filesystem::exists(parsed.path, error) && parsed.path.find_first_of("*?[") == std::string::npos)
+        return "'" + uri + "' has no scheme and is no existing file or folder (e.g. images:DIR, v4l2:/dev/video0)";
+      return "";
+    }
+    std::string known;
+    for (const auto& [scheme, usage] : registeredFrameSourceSchemes()) {
+      if (scheme == parsed.scheme) return "";
+      known += "\n  " + usage;
+    }
+    return "'" + uri + "': unknown scheme '" + parsed.scheme + ":'; use one of:" + known;
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+#else
+  return "this build has no frame sources ('" + uri + "')";
+#endif
+}
+
+std::unique_ptr<FrameSource> openSource(const std::string& uri) {
+#ifdef TOPOSLAM_HAVE_SOURCES
+  registerCameraSchemes();
   return openFrameSource(uri);
 #else
   throw FrameSourceError("cannot open '" + uri + "': this build has no frame sources (toposlam_sources was not "

@@ -9,6 +9,10 @@
 
 namespace toposlam::daemon {
 
+/// "" when `uri` is a source URI toposlamd can open (syntax, known scheme; nothing is opened), else the
+/// problem. --check-config uses it.
+std::string checkSourceUri(const std::string& uri);
+
 /// Throws FrameSourceError (or std::invalid_argument for a malformed URI) with an actionable message.
 std::unique_ptr<FrameSource> openSource(const std::string& uri);
 

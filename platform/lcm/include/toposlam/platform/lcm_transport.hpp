@@ -78,6 +78,11 @@ struct ReceivedMessage {
   bool is_new = false;
 };
 
+/// True when every array length field of an encoded message of `kind` (place, place_event, status,
+/// topology, motion) is >= 0 and fits in the bytes that follow it, so decoding allocates no more than the
+/// message's own size. LcmSubscriber refuses (counts as malformed) a message for which this is false.
+bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size);
+
 class LcmSubscriber {
  public:
   using Callback = std::function<void(const ReceivedMessage&)>;

@@ -1,0 +1,47 @@
+// OutputFile: an output file of the offline commands written so that a reader never sees half of it and
+// a write error is never silent. The text goes to a temporary file beside the target
+// (".<name>.tmp-XXXXXX"); commit() flushes it, checks every write succeeded, fsyncs it and renames it
+// over the target. Any failure (a full disk, EIO, a read-only folder) throws OutputFileError naming the
+// target and the reason, and the target keeps its old content. Not committed (an exception on the way):
+// the temporary file is removed. A target that is not a regular file (/dev/stdout, /dev/full, a FIFO) is
+// written in place, and its write errors are reported just the same.
+// Not thread-safe: one writer per object.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+namespace toposlam {
+
+class OutputFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class OutputFile : public std::ostream {
+ public:
+  /// Creates the temporary file; throws OutputFileError naming `target` when it cannot.
+  explicit OutputFile(std::filesystem::path target);
+  ~OutputFile() override;
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+
+  /// Flushes, checks, fsyncs and renames over the target. Throws OutputFileError; idempotent.
+  void commit();
+  const std::filesystem::path& target() const { return target_; }
+
+ private:
+  class Buffer;
+  std::filesystem::path target_;
+  std::string temp_;  ///< empty when writing in place
+  std::unique_ptr<Buffer> buffer_;
+  bool committed_ = false;
+};
+
+/// Writes `text` to `target` through an OutputFile (temporary name, checked, renamed).
+void writeFileAtomically(const std::filesystem::path& target, const std::string& text);
+
+}  // namespace toposlam

@@ -1,0 +1,48 @@
+// Reading one image file safely: the whole file is read once (up to a size cap), refused when it looks
+// truncated (a JPEG without its end marker decodes as a half-grey frame), its width and height are read
+// from the header (PNG IHDR, JPEG SOFn, BMP info header) and checked against a pixel cap *before* any
+// decoding, and the decoder's own exceptions become an ImageReadError naming the file. A small file that
+// claims 65500x65500 pixels is refused in microseconds instead of asking the decoder for 12 GB.
+// Reentrant; no state.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+namespace toposlam {
+
+/// Default pixel cap of a decoded image: 4096 x 4096 (16.8 megapixels; a 12 MP camera fits).
+inline constexpr std::int64_t kDefaultMaxImagePixels = 4096LL * 4096LL;
+/// Files larger than this are not read (bytes).
+inline constexpr std::uint64_t kMaxImageFileBytes = 256ull << 20;
+
+class ImageReadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ImageHeader {
+  std::string format;  ///< "png", "jpeg", "bmp"
+  std::int64_t width = 0;
+  std::int64_t height = 0;
+};
+
+/// Width and height from the header of PNG, JPEG or BMP bytes, without decoding. nullopt when the bytes
+/// are none of these or the header does not say (the decoder then decides).
+std::optional<ImageHeader> readImageHeader(const unsigned char* data, std::size_t size);
+
+/// Decodes file bytes (cv::imdecode `flags`) after the completeness and pixel-cap checks. Throws
+/// ImageReadError "<name>: <reason>".
+cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, int flags, std::int64_t max_pixels,
+                         const std::string& name);
+
+/// Reads and decodes `path` (see decodeImageBytes). Throws ImageReadError "<path>: <reason>".
+cv::Mat readImageFileChecked(const std::string& path, int flags, std::int64_t max_pixels = kDefaultMaxImagePixels);
+
+}  // namespace toposlam

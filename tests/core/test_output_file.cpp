@@ -1,0 +1,112 @@
+// Tests of OutputFile: written under a temporary name and renamed on commit(); a write error (/dev/full,
+// a file-size limit standing in for a full disk) is an OutputFileError naming the file, and the old
+// content stays.
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "toposlam/core/output_file.hpp"
+
+using namespace toposlam;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path freshDirectory(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("toposlam-output-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string readAll(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream out;
+  out << in.rdbuf();
+  return out.str();
+}
+
+std::size_t filesIn(const fs::path& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN an output file WHEN committed THEN the target holds the text and no temporary file is left",
+          "[core][output][reliability]") {
+  const fs::path dir = freshDirectory("commit");
+  const fs::path target = dir / "frames.csv";
+  std::ofstream(target) << "old";
+  {
+    OutputFile out(target);
+    out << "frame,place\n0,1\n";
+    CHECK(readAll(target) == "old");  // readers see the old file until the rename
+    CHECK(filesIn(dir) == 2);
+    out.commit();
+    out.commit();  // idempotent
+  }
+  CHECK(readAll(target) == "frame,place\n0,1\n");
+  CHECK(filesIn(dir) == 1);
+  SECTION("not committed (an exception on the way): the target keeps its content, the temporary goes") {
+    {
+      OutputFile out(target);
+      out << "half";
+    }
+    CHECK(readAll(target) == "frame,place\n0,1\n");
+    CHECK(filesIn(dir) == 1);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("GIVEN /dev/full WHEN written THEN commit throws naming it", "[core][output][reliability]") {
+  if (!fs::exists("/dev/full")) return;
+  OutputFile out("/dev/full");
+  out << "image,expected\n";
+  CHECK_THROWS_WITH(out.commit(), Catch::Contains("/dev/full: write failed: No space left on device"));
+}
+
+TEST_CASE("GIVEN a folder that does not exist WHEN an output file is opened there THEN the error names it",
+          "[core][output][reliability]") {
+  CHECK_THROWS_WITH(OutputFile("/nonexistent-toposlam-dir/x.csv"),
+                    Catch::Contains("/nonexistent-toposlam-dir/x.csv: cannot create file"));
+}
+
+TEST_CASE("GIVEN a disk that fills up WHEN a large file is committed THEN it throws naming it and the old file stays",
+          "[core][output][reliability]") {
+  const fs::path dir = freshDirectory("full");
+  const fs::path target = dir / "timing.csv";
+  std::ofstream(target) << "old";
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    // RLIMIT_FSIZE stands in for a full disk: writes past 16 KB fail (EFBIG, SIGXFSZ ignored).
+    signal(SIGXFSZ, SIG_IGN);
+    rlimit limit{16 * 1024, 16 * 1024};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      OutputFile out(target);
+      for (int i = 0; i < 10000; ++i) out << i << ",0.1234,0.5678\n";
+      out.commit();
+      _exit(1);  // no error: wrong
+    } catch (const OutputFileError& e) {
+      const std::string what = e.what();
+      _exit(what.find(target.string() + ": write failed: File too large") != std::string::npos ? 0 : 2);
+    }
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  CHECK(readAll(target) == "old");
+  CHECK(filesIn(dir) == 1);
+  fs::remove_all(dir);
+}

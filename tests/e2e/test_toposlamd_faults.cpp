@@ -1,0 +1,265 @@
+// End to end, the real toposlamd under the faults of issue 19, each in a few seconds with LCM on memq://
+// (in process, no network): a damaged map with a good .prev, a second daemon on the same map, temporary
+// files a kill -9 left, a map made with another keypoint backend, frames that claim 65500x65500 pixels,
+// and the signals that used to kill it without a final save (SIGUSR1/2, SIGALRM, SIGPIPE).
+#include <catch2/catch.hpp>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+const std::string kSamples = std::string(TOPOSLAM_SAMPLES_DIR) + "/samples";
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+void nap() {
+  timespec t{0, 20'000'000};  // polling a child or its log, not a synchronisation
+  nanosleep(&t, nullptr);
+}
+
+std::string readText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// toposlamd started with `args` (after the binary), stdout and stderr to `log`.
+pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {}) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    unsetenv("NOTIFY_SOCKET");
+    std::vector<char*> argv;
+    static std::string binary = TOPOSLAMD_BINARY;
+    argv.push_back(binary.data());
+    std::vector<std::string> copy = args;
+    for (std::string& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(binary.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Exit code once `pid` ended within `limit_s` (128 + signal if killed), else -1 (then it is killed).
+int waitForExit(pid_t pid, double limit_s) {
+  const auto start = Clock::now();
+  for (;;) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (secondsSince(start) > limit_s) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return -1;
+    }
+    nap();
+  }
+}
+
+/// True once `log` contains `text` (within `limit_s`).
+bool waitForLog(const fs::path& log, const std::string& text, double limit_s) {
+  const auto start = Clock::now();
+  while (secondsSince(start) < limit_s) {
+    if (readText(log).find(text) != std::string::npos) return true;
+    nap();
+  }
+  return false;
+}
+
+/// Runs toposlamd to the end of a finite source; returns its exit code.
+int runDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {}) {
+  return waitForExit(startDaemon(log, args, cwd), 60.0);
+}
+
+fs::path freshDirectory(const std::string& name) {
+  const fs::path dir = fs::path(TOPOSLAM_BINARY_DIR) / "e2e" / ("faults-" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// A folder with the first `n` samples.
+fs::path sampleFolder(const fs::path& dir, int n) {
+  const fs::path frames = dir / "frames";
+  fs::create_directories(frames);
+  for (int i = 1; i <= n; ++i)
+    fs::copy_file(kSamples + "/" + std::to_string(i) + ".jpg", frames / (std::to_string(i) + ".jpg"));
+  return frames;
+}
+
+std::vector<std::string> daemonArgs(const fs::path& frames, const fs::path& map) {
+  return {"--source", "images:" + frames.string(), "--map", map.string(), "--lcm-url", "memq://"};
+}
+
+std::size_t countPrefix(const fs::path& dir, const std::string& prefix) {
+  std::size_t n = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) n += entry.path().filename().string().rfind(prefix, 0) == 0;
+  return n;
+}
+
+void flipMiddleByte(const fs::path& path) {
+  std::string bytes = readText(path);
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x10);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+}  // namespace
+
+SCENARIO("GIVEN a damaged map.tsm and a good .prev WHEN toposlamd starts THEN it resumes .prev and keeps the damaged file") {
+  const fs::path dir = freshDirectory("damaged");
+  const fs::path frames = sampleFolder(dir, 6);
+  const fs::path map = dir / "map.tsm";
+  REQUIRE(runDaemon(dir / "run1.log", daemonArgs(frames, map)) == 0);
+  REQUIRE(runDaemon(dir / "run2.log", daemonArgs(frames, map)) == 0);  // map.tsm.prev = run 1's map
+  REQUIRE(fs::exists(dir / "map.tsm.prev"));
+  const std::string good_prev = readText(dir / "map.tsm.prev");
+  flipMiddleByte(map);
+
+  const int code = runDaemon(dir / "run3.log", daemonArgs(frames, map));
+  const std::string log = readText(dir / "run3.log");
+  INFO(log);
+  CHECK(code == 0);
+  CHECK_THAT(log, Catch::Contains("checksum mismatch") && Catch::Contains("moved it to " + map.string() + ".damaged-") &&
+                      Catch::Contains("resumed the map " + map.string() + ".prev"));
+  CHECK_FALSE(Catch::Contains("starting a new map").match(log));
+  CHECK(countPrefix(dir, "map.tsm.damaged-") == 1);
+  CHECK(readText(dir / "map.tsm.prev") == good_prev);  // the last good map was not pushed out
+
+  // It happens again (inline, not a WHEN section, so the daemon runs above are not repeated): the earlier
+  // damaged file is kept beside the new one.
+  flipMiddleByte(map);
+  CHECK(runDaemon(dir / "run4.log", daemonArgs(frames, map)) == 0);
+  CHECK(countPrefix(dir, "map.tsm.damaged-") == 2);
+}
+
+SCENARIO("GIVEN temporary files a kill -9 left and a frame claiming 65500x65500 WHEN toposlamd runs THEN the "
+         "orphans go, the frame is skipped and named, and the run ends normally") {
+  const fs::path dir = freshDirectory("orphans");
+  const fs::path frames = sampleFolder(dir, 4);
+  {
+    std::string jpeg = readText(frames / "1.jpg");
+    const std::size_t sof = jpeg.find("\xFF\xC0");
+    REQUIRE(sof != std::string::npos);
+    jpeg[sof + 5] = jpeg[sof + 7] = '\xFF';
+    jpeg[sof + 6] = jpeg[sof + 8] = '\xDC';  // 65500 = 0xFFDC
+    std::ofstream(frames / "3.jpg", std::ios::binary | std::ios::trunc) << jpeg;
+  }
+  const fs::path map = dir / "map.tsm";
+  std::ofstream(dir / ".map.tsm.Ab12Cd") << "half a map";
+  std::ofstream(dir / ".map.tsm.Zz99Yy.prev") << "x";
+  const int code = runDaemon(dir / "run.log", daemonArgs(frames, map));
+  const std::string log = readText(dir / "run.log");
+  INFO(log);
+  CHECK(code == 0);
+  CHECK_THAT(log, Catch::Contains("removed 2 temporary file(s)") &&
+                      Catch::Contains((frames / "3.jpg").string() + ": 65500x65500 pixels"));
+  CHECK_THAT(log, Catch::Contains("3 frames published"));
+  CHECK_FALSE(fs::exists(dir / ".map.tsm.Ab12Cd"));
+  CHECK_FALSE(fs::exists(dir / ".map.tsm.Zz99Yy.prev"));
+  CHECK(fs::exists(map));
+}
+
+SCENARIO("GIVEN a map made with ORB keypoints WHEN toposlamd resumes it with SIFT THEN it refuses naming both") {
+  const fs::path dir = freshDirectory("settings");
+  const fs::path frames = sampleFolder(dir, 3);
+  const fs::path map = dir / "map.tsm";
+  REQUIRE(runDaemon(dir / "orb.log", daemonArgs(frames, map)) == 0);
+  const std::string before = readText(map);
+  std::ofstream(dir / "sift.yaml") << "fingerprint:\n  keypoints:\n    backend: sift\n";
+  std::vector<std::string> args = daemonArgs(frames, map);
+  args.insert(args.end(), {"--config", (dir / "sift.yaml").string()});
+  const int code = runDaemon(dir / "sift.log", args);
+  const std::string log = readText(dir / "sift.log");
+  INFO(log);
+  CHECK(code == 2);  // toposlamd's exit code for a start-up error
+  CHECK_THAT(log, Catch::Contains(map.string()) && Catch::Contains("keypoints=orb") && Catch::Contains("keypoints=sift"));
+  CHECK(readText(map) == before);  // nothing moved or overwritten
+  CHECK(countPrefix(dir, "map.tsm.damaged") == 0);
+}
+
+SCENARIO("GIVEN a running toposlamd WHEN a second one starts on its map, and it gets SIGUSR1, SIGUSR2, SIGALRM and "
+         "SIGPIPE THEN the second is refused naming the lock, and the first saves and exits 0 on SIGQUIT") {
+  const fs::path dir = freshDirectory("lock");
+  const fs::path map = dir / "map.tsm";
+  const std::vector<std::string> args = {"--source", "sim:office?route=loop2&size=160x120&rate=10", "--map",
+                                         map.string(), "--lcm-url", "memq://"};
+  const pid_t first = startDaemon(dir / "first.log", args);
+  REQUIRE(first > 0);
+  const bool running = waitForLog(dir / "first.log", "toposlamd: running", 30.0);
+  INFO(readText(dir / "first.log"));
+  REQUIRE(running);
+
+  const int second = runDaemon(dir / "second.log", args);
+  const std::string second_log = readText(dir / "second.log");
+  INFO(second_log);
+  CHECK(second == 2);  // a start-up error
+  CHECK_THAT(second_log, Catch::Contains("in use by another toposlam process (process " + std::to_string(first) + ")") &&
+                             Catch::Contains(map.string() + ".lock"));
+
+  for (int s : {SIGUSR1, SIGUSR2, SIGALRM}) {
+    kill(first, s);
+    CHECK(waitForLog(dir / "first.log", std::string(strsignal(s)) + " received: ignored", 10.0));
+  }
+  kill(first, SIGPIPE);
+  kill(first, SIGQUIT);
+  const int code = waitForExit(first, 30.0);
+  const std::string log = readText(dir / "first.log");
+  INFO(log);
+  CHECK(code == 0);
+  CHECK_THAT(log, Catch::Contains("received: finishing the filter step"));
+  CHECK(fs::exists(map));
+}
+
+SCENARIO("GIVEN --map \"\" WHEN toposlamd runs THEN no map file is written (not even ./map.tsm)") {
+  const fs::path dir = freshDirectory("no-map");
+  const fs::path frames = sampleFolder(dir, 3);
+  unsetenv("STATE_DIRECTORY");
+  const int code = runDaemon(dir / "run.log", {"--source", "images:" + frames.string(), "--map", "", "--lcm-url", "memq://"}, dir);
+  INFO(readText(dir / "run.log"));
+  CHECK(code == 0);
+  CHECK_FALSE(fs::exists(dir / "map.tsm"));
+  CHECK(countPrefix(dir, "map.tsm") == 0);
+}
+
+SCENARIO("GIVEN toposlamd whose log pipe is closed (the reader gone) WHEN it runs THEN it is not killed by SIGPIPE "
+         "and saves its map") {
+  const fs::path dir = freshDirectory("closed-pipe");
+  const fs::path frames = sampleFolder(dir, 3);
+  const fs::path map = dir / "map.tsm";
+  int pipe_fds[2];
+  REQUIRE(pipe(pipe_fds) == 0);
+  close(pipe_fds[0]);  // no reader: every log write fails with EPIPE (and raises SIGPIPE)
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(pipe_fds[1], 1);
+    dup2(pipe_fds[1], 2);
+    signal(SIGPIPE, SIG_DFL);  // as a shell would start it
+    const std::string binary = TOPOSLAMD_BINARY;
+    execl(binary.c_str(), binary.c_str(), "--source", ("images:" + frames.string()).c_str(), "--map", map.c_str(),
+          "--lcm-url", "memq://", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(pipe_fds[1]);
+  const int code = waitForExit(pid, 60.0);
+  CHECK(code == 0);  // 141 = killed by SIGPIPE
+  CHECK(fs::exists(map));
+}

@@ -1,0 +1,107 @@
+// Writes the seed corpora of the fuzz targets (tests/fuzz/corpus/<target>/) from real encoders, so a seed
+// is a valid input the fuzzer mutates from. Run once by hand when a format changes:
+//   build/tests/fuzz/fuzz_make_seeds tests/fuzz/corpus
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "topology/fake_similarity.hpp"
+#include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/topology/map_store.hpp"
+#include "toposlam_lcm/motion_t.hpp"
+#include "toposlam_lcm/place_event_t.hpp"
+#include "toposlam_lcm/place_t.hpp"
+#include "toposlam_lcm/status_t.hpp"
+#include "toposlam_lcm/topology_t.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void write(const fs::path& path, const std::string& bytes) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+template <typename Message>
+std::string encoded(char kind, const Message& m) {
+  std::string bytes(static_cast<std::size_t>(m.getEncodedSize()), '\0');
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return std::string(1, kind) + bytes;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) return 2;
+  const fs::path out(argv[1]);
+  using namespace toposlam;
+
+  // Map files: a small filter, as a whole file (mode byte 0) and as a bare payload (mode byte 1).
+  auto similarity = test::placeSimilarity();
+  TopologyFilterConfig config;
+  config.particles = 8;
+  TopologyParticleFilter filter(config, similarity);
+  for (int k = 0; k < 5; ++k) filter.step(test::taggedFingerprint(k % 3));
+  const std::string file = MapStore::encode(filter, "toposlamd-frames 1 2 3", MapSettings{{"keypoints", "orb"}});
+  write(out / "map_file" / "whole", std::string(1, '\0') + file);
+  write(out / "map_file" / "payload", std::string(1, '\1') + file.substr(32));
+  TopologyParticleFilter empty(config, similarity);
+  write(out / "map_file" / "empty", std::string(1, '\0') + MapStore::encode(empty));
+
+  // Configs: the shipped one and a few small ones.
+  write(out / "config" / "small", "source: images:frames\nmap:\n  path: m.tsm\n  save_period_s: 5\n");
+  write(out / "config" / "nested", "pipeline:\n  queues: {frames: 4, overflow: block}\ntopology: {particles: 50}\n");
+  write(out / "config" / "two_documents", "source: images:a\n---\nsource: images:b\n");
+
+  // Fingerprints of a real frame, with ORB and SIFT keypoints.
+  const cv::Mat frame = cv::imread(std::string(TOPOSLAM_SAMPLES_DIR) + "/samples/1.jpg", cv::IMREAD_COLOR);
+  for (KeypointBackend backend : {KeypointBackend::Orb, KeypointBackend::Sift}) {
+    VpackConfig vpack;
+    vpack.keypoints.backend = backend;
+    vpack.keypoints.max_keypoints = 12;
+    std::ostringstream bytes;
+    writeFingerprint(bytes, VpackExtractor(vpack).extract(frame));
+    write(out / "fingerprint" / toString(backend), bytes.str());
+  }
+
+  // Image headers: tiny PNG, JPEG and BMP files.
+  const cv::Mat small = cv::Mat(6, 9, CV_8UC3, cv::Scalar(20, 120, 220));
+  for (const char* ext : {".png", ".jpg", ".bmp"}) {
+    std::vector<unsigned char> bytes;
+    cv::imencode(ext, small, bytes);
+    write(out / "image_header" / (std::string("small") + ext), std::string(bytes.begin(), bytes.end()));
+  }
+
+  // LCM messages, one of each type (byte 0 selects the type in the harness).
+  toposlam_lcm::place_t place{};
+  place.num_alternatives = 2;
+  place.alternatives.resize(2);
+  write(out / "lcm_messages" / "place", encoded('\0', place));
+  toposlam_lcm::place_event_t event{};
+  event.jpeg_size = 4;
+  event.jpeg = {0xFF, 0xD8, 0xFF, 0xD9};
+  write(out / "lcm_messages" / "place_event", encoded('\1', event));
+  toposlam_lcm::status_t status{};
+  status.state = "running";
+  status.source_state = "streaming";
+  status.num_stages = 1;
+  status.stages.resize(1);
+  status.stages[0].name = "capture";
+  write(out / "lcm_messages" / "status", encoded('\2', status));
+  toposlam_lcm::topology_t topology{};
+  topology.num_nodes = 1;
+  topology.nodes.resize(1);
+  topology.nodes[0].num_places = 1;
+  topology.nodes[0].places = {0};
+  topology.nodes[0].num_representatives = 1;
+  topology.nodes[0].representative_frames = {3};
+  write(out / "lcm_messages" / "topology", encoded('\3', topology));
+  write(out / "lcm_messages" / "motion", encoded('\4', toposlam_lcm::motion_t{}));
+  return 0;
+}
