@@ -409,3 +409,65 @@ TEST_CASE("GIVEN bad input WHEN added THEN it is refused with a clear message", 
     CHECK_THROWS_WITH(toposlam::parseCutPlacement("middle"), Catch::Contains("window-split"));
   }
 }
+
+TEST_CASE(
+    "GIVEN the same places filmed at 5, 10 and 15 fps WHEN the window is in seconds THEN the borders fall at "
+    "the same times",
+    "[segmentation][time]") {
+  // Four places of 8, 12, 6 and 10 seconds. At f fps frame k is taken at k / f s and shows the place of
+  // that time; similarities as in the block streams above.
+  const std::vector<double> ends = {8.0, 20.0, 26.0, 36.0};
+  const auto placeAt = [&](double t) {
+    int p = 0;
+    while (p + 1 < static_cast<int>(ends.size()) && t >= ends[static_cast<std::size_t>(p)]) ++p;
+    return p;
+  };
+  std::vector<std::vector<double>> border_times;
+  for (const double fps : {5.0, 10.0, 15.0}) {
+    const int frames = static_cast<int>(ends.back() * fps);
+    std::vector<int> labels;
+    for (int k = 0; k < frames; ++k) labels.push_back(placeAt(k / fps));
+    TableSimilarity similarity([&](int a, int b) { return blockSimilarity(labels, a, b); });
+    FiedlerSegmenterConfig config;
+    config.window_s = 5.0;   // the thesis' 25 frames at 5 fps
+    config.window = 200;     // room for 15 fps
+    config.min_window_frames = 5;
+    FiedlerSegmenter segmenter(config, similarity);
+    std::vector<double> borders;
+    for (int k = 0; k < frames; ++k) {
+      const auto step = segmenter.addFrame(k, k / fps, fakeFingerprint(k));
+      if (k > 0) CHECK(segmenter.windowFrames() <= static_cast<int>(std::lround(5.0 * fps)) + 1);
+      if (step.closed_place) borders.push_back(step.closed_place->last_time_s);
+    }
+    INFO(fps << " fps: " << borders.size() << " borders");
+    REQUIRE(borders.size() == 3);
+    border_times.push_back(borders);
+  }
+  // The same borders in time, within a frame of the slowest rate (0.2 s) plus rounding of the split.
+  for (std::size_t b = 0; b < 3; ++b) {
+    INFO("border " << b << ": " << border_times[0][b] << " s, " << border_times[1][b] << " s, " << border_times[2][b] << " s");
+    CHECK(std::fabs(border_times[1][b] - border_times[0][b]) <= 0.45);
+    CHECK(std::fabs(border_times[2][b] - border_times[0][b]) <= 0.45);
+    CHECK(std::fabs(border_times[0][b] - ends[b]) <= 0.45);
+  }
+}
+
+TEST_CASE("GIVEN a window in seconds WHEN frames arrive THEN it holds the last window_s of them, bounded in frames",
+          "[segmentation][time]") {
+  TableSimilarity similarity([](int, int) { return 0.5; });
+  FiedlerSegmenterConfig config;
+  config.window_s = 2.0;
+  config.window = 50;
+  config.min_window_frames = 4;
+  FiedlerSegmenter segmenter(config, similarity);
+  // 10 fps: frames less than 2 s old, i.e. 20.
+  for (int k = 0; k < 40; ++k) segmenter.addFrame(k, 0.1 * k, fakeFingerprint(k));
+  CHECK(segmenter.windowFrames() == 20);
+  CHECK(segmenter.windowFull());
+  // A gap of 10 s: the time rule would empty the window; it keeps min_window_frames.
+  segmenter.addFrame(40, 14.0, fakeFingerprint(40));
+  CHECK(segmenter.windowFrames() == 4);
+  // 100 fps: the frame bound (50) wins.
+  for (int k = 41; k < 200; ++k) segmenter.addFrame(k, 14.0 + 0.01 * (k - 40), fakeFingerprint(k));
+  CHECK(segmenter.windowFrames() == 50);
+}

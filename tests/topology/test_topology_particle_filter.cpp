@@ -313,3 +313,40 @@ TEST_CASE(
   CHECK(stateBytes(*loaded.filter) == stateBytes(straight));
   CHECK(loaded.filter->estimate().best.assignment == straight.estimate().best.assignment);
 }
+
+TEST_CASE("GIVEN similarities among stored representatives WHEN made relative THEN the likelihood follows the z-score",
+          "[topology][relative]") {
+  // Leave-one-out z against 4 others at 0.02, 0.03, 0.04, 0.05 (mean 0.035, std 0.0112, above the floor).
+  const double sum = 0.14, sum_sq = 0.02 * 0.02 + 0.03 * 0.03 + 0.04 * 0.04 + 0.05 * 0.05;
+  const double z = (0.2 - 0.035) / std::sqrt(sum_sq / 4 - 0.035 * 0.035);
+  CHECK(relativeLikelihood(0.2, sum, sum_sq, 4, 2.0, 8.0, 0.02) ==
+        Approx(1.0 / (1.0 + std::exp(-2.0 * ((0.2 - 0.035) / 0.02 - 8.0)))));  // std 0.0112 < floor 0.02
+  CHECK(z > 14.0);
+  CHECK(relativeLikelihood(0.035, sum, sum_sq, 4, 2.0, 8.0, 0.02) < 1e-6);  // an average one: no evidence
+  // No other representative: z = 0.
+  CHECK(relativeLikelihood(0.9, 0.0, 0.0, 0, 2.0, 8.0, 0.02) == Approx(1.0 / (1.0 + std::exp(16.0))));
+  CHECK(parseLikelihoodModel("relative") == LikelihoodModel::Relative);
+  CHECK_THROWS_AS(parseLikelihoodModel("bayes"), std::invalid_argument);
+}
+
+TEST_CASE(
+    "GIVEN a revisit at real similarity levels WHEN filtered THEN the relative likelihood closes the loop and the "
+    "thesis' absolute one cannot",
+    "[topology][relative]") {
+  // Real frames: a revisit scores about 0.3, other places 0.01-0.06 (docs/topology.md). Two laps of 8.
+  auto sim = TagSimilarity([](int a, int b) { return a == b ? 0.3 : 0.01 + 0.01 * ((a * 7 + b * 3) % 6); });
+  const std::vector<int> places = route(8, 2);
+  for (std::uint64_t seed : {1u, 7u}) {
+    TopologyFilterConfig relative = configWith(500, seed);
+    relative.likelihood = LikelihoodModel::Relative;
+    relative.relative_slope = 2.0;
+    relative.relative_offset = 8.0;
+    TopologyParticleFilter with_relative(relative, sim);
+    run(with_relative, places);
+    CHECK(with_relative.estimate().best.assignment == places);
+    CHECK(with_relative.estimate().best.probability > 0.5);
+    TopologyParticleFilter with_absolute(configWith(500, seed), sim);
+    run(with_absolute, places);
+    CHECK(with_absolute.estimate().best.node_count == 16);  // every place a new node: no closure
+  }
+}

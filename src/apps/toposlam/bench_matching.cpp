@@ -14,6 +14,7 @@
 #include "image_input.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/matching/similarity_preset.hpp"
 
 namespace toposlam::cli {
 
@@ -26,6 +27,7 @@ struct MatchingBenchOptions {
   int width = 640;
   int height = 480;
   std::vector<std::string> backends = {"orb"};
+  std::vector<std::string> presets = {"default", "thesis"};
 };
 
 void runMatchingBench(const MatchingBenchOptions& o) {
@@ -35,11 +37,13 @@ void runMatchingBench(const MatchingBenchOptions& o) {
   if (static_cast<int>(frames.size()) > o.frames) frames.resize(static_cast<std::size_t>(o.frames));
   std::cout << "n-gram similarity, one thread, " << frames.size() << " frames at " << size.width << "x"
             << size.height << ", all ordered pairs x " << o.repeat << " passes (" << o.samples << ")\n";
-  std::cout << std::left << std::setw(8) << "kp" << std::right << std::setw(10) << "pairs" << std::setw(14)
+  std::cout << std::left << std::setw(16) << "preset kp" << std::right << std::setw(10) << "pairs" << std::setw(14)
             << "keypoints/f" << std::setw(13) << "letters/f" << std::setw(13) << "median us" << std::setw(10)
             << "p99 us" << std::setw(16) << "median sim/s" << std::setw(14) << "worst sim/s" << "\n";
+  for (const std::string& preset_name : o.presets)
   for (const std::string& backend : o.backends) {
-    VpackConfig config;
+    const SimilarityPreset preset = similarityPreset(preset_name);
+    VpackConfig config = preset.fingerprint;
     config.keypoints.backend = parseKeypointBackend(backend);
     const VpackExtractor extractor(config);
     std::vector<Fingerprint> prints;
@@ -49,7 +53,7 @@ void runMatchingBench(const MatchingBenchOptions& o) {
       keypoints += prints.back().keypointCount();
       letters += static_cast<double>(prints.back().subregions.size());
     }
-    const NgramSimilarity similarity;
+    const NgramSimilarity similarity(preset.similarity);
     MatchScratch scratch;
     std::vector<double> call_ms;     // one entry per similarity
     std::vector<double> pass_rates;  // similarities per second, one entry per pass
@@ -72,7 +76,7 @@ void runMatchingBench(const MatchingBenchOptions& o) {
     const TimingSummary s = summarize(call_ms);
     std::sort(pass_rates.begin(), pass_rates.end());
     const std::size_t n = prints.size();
-    std::cout << std::left << std::setw(8) << backend << std::right << std::setw(10) << pairs << std::fixed
+    std::cout << std::left << std::setw(16) << (preset_name + " " + backend) << std::right << std::setw(10) << pairs << std::fixed
               << std::setprecision(1) << std::setw(14) << keypoints / static_cast<double>(n) << std::setw(13)
               << letters / static_cast<double>(n) << std::setw(13) << 1000.0 * s.median_ms << std::setw(10)
               << 1000.0 * s.p99_ms << std::setprecision(0) << std::setw(16) << pass_rates[pass_rates.size() / 2]
@@ -96,6 +100,7 @@ void addBenchMatching(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--height", options->height, "Frame height after resizing")->check(CLI::Range(48, 4096))
       ->capture_default_str();
+  cmd->add_option("--preset", options->presets, "Presets to measure (default, thesis)")->capture_default_str();
   cmd->add_option("--keypoints", options->backends, "Backends to measure (orb, sift, brisk, akaze)")
       ->capture_default_str();
   cmd->callback([options] { runMatchingBench(*options); });

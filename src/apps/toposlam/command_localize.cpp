@@ -23,6 +23,7 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/labelled_image_list.hpp"
 #include "toposlam/matching/place_localizer.hpp"
+#include "toposlam/matching/similarity_preset.hpp"
 
 namespace toposlam::cli {
 
@@ -36,6 +37,7 @@ struct LocalizeOptions {
   std::string keypoints = "orb";
   bool normalise_counts = false;
   bool json = false;
+  std::string preset = "default";
 };
 
 struct Prediction {
@@ -103,7 +105,8 @@ void runLocalize(const LocalizeOptions& o) {
   const LabelledImageList place_list = readListReporting(o.places, problems);
   const LabelledImageList query_list = readListReporting(o.queries, problems);
 
-  VpackConfig vpack;
+  const SimilarityPreset preset = similarityPreset(o.preset);
+  VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   const VpackExtractor extractor(vpack);
 
@@ -125,6 +128,7 @@ void runLocalize(const LocalizeOptions& o) {
                              " problems reported above)");
 
   PlaceLocalizerConfig config;
+  config.similarity = preset.similarity;
   config.normalise_counts = o.normalise_counts;
   const PlaceLocalizer localizer(config, std::move(places));
 
@@ -221,6 +225,8 @@ void addLocalizeCommand(CLI::App& app) {
   cmd->add_flag("--normalise-counts", options->normalise_counts,
                 "Divide each place's n-gram counts by the n-grams its representative could have had");
   cmd->add_flag("--json", options->json, "Print JSON instead of the table");
+  cmd->add_option("--preset", options->preset, "Method preset: default (measured on real frames) or thesis")
+      ->capture_default_str();
   cmd->callback([options] { runLocalize(*options); });
 }
 

@@ -12,6 +12,7 @@
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/matching/similarity_preset.hpp"
 
 namespace toposlam::cli {
 
@@ -22,6 +23,7 @@ struct SimilarityOptions {
   std::string second;
   std::string keypoints = "orb";
   bool json = false;
+  std::string preset = "default";
 };
 
 // "2.450/5" style cell: effective count over the n-grams the reference could have had.
@@ -88,12 +90,13 @@ void describe(const std::string& label, const std::string& path, const Fingerpri
 }
 
 void runSimilarity(const SimilarityOptions& o) {
-  VpackConfig config;
+  const SimilarityPreset preset = similarityPreset(o.preset);
+  VpackConfig config = preset.fingerprint;
   config.keypoints.backend = parseKeypointBackend(o.keypoints);
   const VpackExtractor extractor(config);
   const Fingerprint a = fingerprintImageFile(extractor, o.first);
   const Fingerprint b = fingerprintImageFile(extractor, o.second);
-  const NgramSimilarity similarity;
+  const NgramSimilarity similarity(preset.similarity);
   const SimilarityBreakdown ab = similarity.explain(a, b);
   const SimilarityBreakdown ba = similarity.explain(b, a);
   const double symmetric = 0.5 * (ab.similarity + ba.similarity);
@@ -124,6 +127,8 @@ void addSimilarityCommand(CLI::App& app) {
   cmd->add_option("b", options->second, "Second image")->required();
   addKeypointBackendOption(*cmd, options->keypoints);
   cmd->add_flag("--json", options->json, "Print JSON instead of text");
+  cmd->add_option("--preset", options->preset, "Method preset: default (measured on real frames) or thesis")
+      ->capture_default_str();
   cmd->callback([options] { runSimilarity(*options); });
 }
 
