@@ -79,6 +79,7 @@ Localization PlaceLocalizer::localize(const Fingerprint& query) const {
   Localization result;
   const std::size_t k_places = places_.size();
   result.places.resize(k_places);
+  const bool verified = config_.similarity.keypoint_scoring == KeypointScoring::VerifiedMatches;
   std::array<std::vector<double>, kMaxNgramOrder> histogram_counts;
   std::array<std::vector<double>, kMaxNgramOrder> keypoint_counts;
   for (int n = 0; n < kMaxNgramOrder; ++n) {
@@ -101,7 +102,12 @@ Localization PlaceLocalizer::localize(const Fingerprint& query) const {
       const NgramCounts& c = evidence.counts;
       double h = c.histogram[n];
       double kp = c.keypoint[n];
-      if (config_.normalise_counts) {
+      if (verified) {
+        // Verified matches lying on complete keypoint n-grams, over the smaller keypoint count
+        // (docs/matching.md): the same evidence the default similarity scores.
+        const int smaller = std::max(1, std::min(c.reference_keypoints, c.query_keypoints));
+        kp = static_cast<double>(c.keypoint_ngram_matches[n]) / smaller;
+      } else if (config_.normalise_counts) {
         h = c.histogram_possible[n] > 0 ? h / c.histogram_possible[n] : 0.0;
         kp = c.keypoint_possible[n] > 0 ? kp / c.keypoint_possible[n] : 0.0;
       }
@@ -112,8 +118,13 @@ Localization PlaceLocalizer::localize(const Fingerprint& query) const {
   result.histogram = interpolate(histogram_counts, config_.laplace_alpha);
   result.keypoint = interpolate(keypoint_counts, config_.laplace_alpha);
   result.probabilities.assign(k_places, 0.0);
+  // Thesis: histogram model x keypoint model. Verified-match scoring weighs them geometrically by the
+  // similarity's histogram weight (0.05 in the default preset: nearly the keypoint model alone).
+  const double w = verified ? config_.similarity.histogram_weight : 0.5;
   for (std::size_t k = 0; k < k_places; ++k)
-    result.probabilities[k] = result.histogram.probabilities[k] * result.keypoint.probabilities[k];
+    result.probabilities[k] = verified ? std::pow(result.histogram.probabilities[k], 2.0 * w) *
+                                             std::pow(result.keypoint.probabilities[k], 2.0 * (1.0 - w))
+                                       : result.histogram.probabilities[k] * result.keypoint.probabilities[k];
   normalise(result.probabilities);
   const auto best = std::max_element(result.probabilities.begin(), result.probabilities.end());
   result.best_place = static_cast<int>(best - result.probabilities.begin());
