@@ -4,6 +4,9 @@
 #include <glob.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <cmath>
+#include <map>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -124,13 +127,45 @@ ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double times
       rate_given_(rate_given) {
   if (!(rate_hz_ > 0)) throw FrameSourceError("images: rate must be > 0 Hz");
   if (max_pixels_ < 1) throw FrameSourceError("images: max_pixels must be >= 1");
+  // The frames' own capture times, when a timestamps.csv (name,time_s) lies beside them (`toposlam sim`
+  // writes one): the segmentation window is in seconds. An explicit ?fps= wins.
+  if (!rate_given_ && !files_.empty()) {
+    const fs::path table = fs::path(files_.front()).parent_path() / "timestamps.csv";
+    std::ifstream in(table);
+    std::string line;
+    if (in && std::getline(in, line)) {
+      std::map<std::string, double> time_of;
+      int line_number = 1;
+      while (std::getline(in, line)) {
+        ++line_number;
+        const auto comma = line.rfind(',');
+        char* end = nullptr;
+        const double t = comma == std::string::npos ? 0.0 : std::strtod(line.c_str() + comma + 1, &end);
+        if (comma == std::string::npos || end == line.c_str() + comma + 1 || !std::isfinite(t))
+          throw FrameSourceError(table.string() + ":" + std::to_string(line_number) + ": expected name,time_s");
+        time_of[line.substr(0, comma)] = t;
+      }
+      for (const std::string& file : files_) {
+        const auto it = time_of.find(fs::path(file).filename().string());
+        if (it == time_of.end()) {
+          times_.clear();
+          spdlog::warn("images: {} has no time for {}: timestamps at 1 fps instead", table.string(), file);
+          break;
+        }
+        times_.push_back(it->second);
+      }
+      if (!times_.empty()) timestamps_file_ = table.string();
+    }
+  }
 }
 
 std::string ImageFilesSource::describe() const {
   std::ostringstream rate;
   rate << rate_hz_;
-  return "images:" + origin_ + " (" + std::to_string(files_.size()) + " frames, " +
-         (rate_given_ ? rate.str() + " fps" : "no frame rate given: timestamps at 1 fps, set ?fps=HZ") + ")";
+  const std::string timing = rate_given_                 ? rate.str() + " fps"
+                             : !timestamps_file_.empty() ? "times from " + timestamps_file_
+                                                         : "no frame rate given: timestamps at 1 fps, set ?fps=HZ";
+  return "images:" + origin_ + " (" + std::to_string(files_.size()) + " frames, " + timing + ")";
 }
 
 std::optional<Frame> ImageFilesSource::next() {
@@ -152,7 +187,7 @@ std::optional<Frame> ImageFilesSource::next() {
     Frame frame;
     frame.image = image;
     frame.sequence = static_cast<std::int64_t>(index);
-    frame.timestamp_s = static_cast<double>(index) / rate_hz_;
+    frame.timestamp_s = times_.empty() ? static_cast<double>(index) / rate_hz_ : times_[index];
     frame.name = fs::path(file).filename().string();
     return frame;
   }

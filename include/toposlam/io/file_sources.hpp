@@ -32,7 +32,8 @@ class ImageFilesSource : public FrameSource {
  public:
   /// timestamps are file index / timestamp_rate_hz (the bundled samples are ~1 Hz keyframes). A file whose
   /// header claims more than max_pixels pixels is skipped undecoded (image_file.hpp). rate_given = false:
-  /// the rate is an assumption, and describe() says so.
+  /// the rate is an assumption, and describe() says so; then a timestamps.csv (name,time_s) beside the
+  /// files, as `toposlam sim` writes, gives each frame its own time.
   ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz = 1.0,
                    std::int64_t max_pixels = kDefaultMaxImagePixels, bool rate_given = true);
   std::string describe() const override;
@@ -48,6 +49,8 @@ class ImageFilesSource : public FrameSource {
   double rate_hz_;
   std::int64_t max_pixels_;
   bool rate_given_ = true;
+  std::vector<double> times_;    ///< per file, from timestamps.csv beside the files; empty = index / rate
+  std::string timestamps_file_;  ///< that file, for describe()
   std::size_t next_index_ = 0;
   std::int64_t skipped_ = 0;
   std::atomic<bool> interrupted_{false};

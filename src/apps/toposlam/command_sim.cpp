@@ -72,6 +72,10 @@ void runSim(const SimOptions& options) {
   std::ofstream labels(out / "labels.csv");
   if (!labels) throw std::runtime_error("--out: cannot write '" + (out / "labels.csv").string() + "'");
   labels << "frame,time,room,x,y,heading,traversal\n";
+  // The frames' capture times, read back by images: sources (the segmentation window is in seconds).
+  std::ofstream timestamps(out / "frames" / "timestamps.csv");
+  if (!timestamps) throw std::runtime_error("--out: cannot write '" + (out / "frames" / "timestamps.csv").string() + "'");
+  timestamps << "name,time_s\n";
   std::vector<sim::Pose> poses;
   std::vector<int> traversals, rooms;
   const std::int64_t frames = simulator.frameCount();
@@ -89,6 +93,9 @@ void runSim(const SimOptions& options) {
                   frame.truth.time_s, frame.truth.room, frame.truth.pose.x, frame.truth.pose.y,
                   frame.truth.pose.heading, frame.truth.traversal);
     labels << row;
+    char stamp[64];
+    std::snprintf(stamp, sizeof stamp, "%s,%.6f\n", name, frame.truth.time_s);
+    timestamps << stamp;
     poses.push_back(frame.truth.pose);
     traversals.push_back(frame.truth.traversal);
     rooms.push_back(frame.truth.room);
@@ -97,6 +104,8 @@ void runSim(const SimOptions& options) {
     }
   }
   if (!labels) throw std::runtime_error("--out: error while writing labels.csv");
+  timestamps.flush();
+  if (!timestamps) throw std::runtime_error("--out: error while writing frames/timestamps.csv");
   cv::imwrite((out / "loop_closure.png").string(), sim::loopClosureMatrix(rooms));
   cv::imwrite((out / "map.png").string(),
               sim::drawWorldMap(simulator.world(), poses, traversals, 40.0, static_cast<int>(config.fps * 5)));
