@@ -5,6 +5,8 @@
 #include <map>
 #include <sstream>
 
+#include <spdlog/spdlog.h>
+
 #include "toposlam/topology/map_store.hpp"
 
 namespace toposlam {
@@ -37,7 +39,17 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   }
   for (const MotionSample& m : applying_) gate_.addSample(m.time_s, m.distance_increment_m, m.speed_mps);
   applying_.clear();
+  const bool was_known = last_motion_.known;
   last_motion_ = gate_.at(captured_at_s);
+  if (last_motion_.known != was_known) {
+    if (last_motion_.known) {
+      spdlog::info("segmentation: robot motion known; standing frames skipped{}",
+                   segmenter_.config().window_m > 0.0 ? ", window in metres" : "");
+    } else if (gate_.samples() > 0) {
+      spdlog::warn("segmentation: robot motion lost (no sample for {} s); segmenting by time",
+                   gate_.config().timeout_s);
+    }
+  }
   thumbnails_.emplace(sequence, thumbnail);
   if (thumbnails_.size() > max_thumbnails_) thumbnails_.erase(thumbnails_.begin());
   // The segmenter's time is the frame number (toposlamd's frames carry no trustworthy source time; see
