@@ -144,7 +144,7 @@ class FiedlerSegmenter {
   const FiedlerSegmenterConfig& config() const { return config_; }
   /// Frames currently in the window (<= config().window).
   int windowFrames() const { return count_; }
-  /// True once the window spans its full length (window_s, or `window` frames): lambda2 goes to the
+  /// True once the window spans its full length (window_m, window_s, or `window` frames): lambda2 goes to the
   /// valley detector only from then on.
   bool windowFull() const { return window_full_; }
   /// First frame of the open place, or -1 before any frame.
