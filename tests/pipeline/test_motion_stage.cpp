@@ -29,8 +29,10 @@ FiedlerSegmenterConfig stageConfig() {
 }
 }  // namespace
 
-TEST_CASE("GIVEN no motion sample WHEN frames go through the stage THEN lambda2 equals the plain segmenter's exactly",
-          "[pipeline][motion]") {
+TEST_CASE(
+    "GIVEN no motion sample WHEN frames go through the stage THEN lambda2 equals the plain segmenter's "
+    "exactly",
+    "[pipeline][motion]") {
   const TableSimilarity similarity(blocks);
   FiedlerSegmentationStage stage(stageConfig(), similarity);
   FiedlerSegmenter plain(stageConfig(), similarity);
@@ -48,9 +50,11 @@ TEST_CASE("GIVEN no motion sample WHEN frames go through the stage THEN lambda2 
   CHECK_FALSE(stage.lastMotion().known);
 }
 
-TEST_CASE("GIVEN motion samples from another thread saying the robot stands WHEN frames arrive THEN they are skipped; "
-          "once the samples stop, motion is unknown and frames are added again",
-          "[pipeline][motion]") {
+TEST_CASE(
+    "GIVEN motion samples from another thread saying the robot stands WHEN frames arrive THEN they are "
+    "skipped; "
+    "once the samples stop, motion is unknown and frames are added again",
+    "[pipeline][motion]") {
   const TableSimilarity similarity(blocks);
   MotionGateConfig gate;
   gate.standing_after_s = 1.0;
@@ -68,7 +72,7 @@ TEST_CASE("GIVEN motion samples from another thread saying the robot stands WHEN
       CHECK(std::isnan(step.lambda2));
     }
   }
-  CHECK(stage.skippedFrames() == 23);  // frames 5 .. 27 (101.0 .. 105.4 s)
+  CHECK(stage.skippedFrames() == 23);     // frames 5 .. 27 (101.0 .. 105.4 s)
   CHECK_FALSE(stage.lastMotion().known);  // 105.8 s: the newest sample is 0.8 s old
   CHECK(stage.refusedMotionSamples() == 0);
   stage.addMotion(MotionSample{50.0, 0.0, 0.0});  // back in time: refused by the gate
@@ -76,8 +80,10 @@ TEST_CASE("GIVEN motion samples from another thread saying the robot stands WHEN
   CHECK(stage.refusedMotionSamples() == 1);
 }
 
-TEST_CASE("GIVEN more samples than the queue holds before a frame WHEN added THEN the oldest are dropped and counted",
-          "[pipeline][motion]") {
+TEST_CASE(
+    "GIVEN more samples than the queue holds before a frame WHEN added THEN the oldest are dropped and "
+    "counted",
+    "[pipeline][motion]") {
   const TableSimilarity similarity(blocks);
   FiedlerSegmentationStage stage(stageConfig(), similarity);
   const auto n = static_cast<int>(FiedlerSegmentationStage::kMaxPendingMotion) + 10;
@@ -85,5 +91,6 @@ TEST_CASE("GIVEN more samples than the queue holds before a frame WHEN added THE
   CHECK(stage.droppedMotionSamples() == 10);
   stage.process(0, 0.01 * n, fakeFingerprint(0), cv::Mat());
   CHECK(stage.lastMotion().known);
-  CHECK(stage.lastMotion().distance_m == Approx(0.001 * static_cast<double>(FiedlerSegmentationStage::kMaxPendingMotion)));
+  CHECK(stage.lastMotion().distance_m ==
+        Approx(0.001 * static_cast<double>(FiedlerSegmentationStage::kMaxPendingMotion)));
 }

@@ -29,8 +29,10 @@ TEST_CASE("GIVEN no motion sample WHEN a frame time is asked THEN motion is unkn
   CHECK(s.distance_m == 0.0);
 }
 
-TEST_CASE("GIVEN samples of a moving robot WHEN asked THEN distance is the sum of |increments| and it is not standing",
-          "[motion_gate]") {
+TEST_CASE(
+    "GIVEN samples of a moving robot WHEN asked THEN distance is the sum of |increments| and it is not "
+    "standing",
+    "[motion_gate]") {
   MotionGate gate(gateConfig());
   for (int i = 1; i <= 10; ++i) REQUIRE(gate.addSample(0.1 * i, 0.03, 0.3));
   REQUIRE(gate.addSample(1.1, -0.03, -0.3));  // reversing is travel too
@@ -41,8 +43,10 @@ TEST_CASE("GIVEN samples of a moving robot WHEN asked THEN distance is the sum o
   CHECK(gate.samples() == 11);
 }
 
-TEST_CASE("GIVEN the robot slows below the threshold WHEN standing_after_s has passed THEN it stands, and not before",
-          "[motion_gate]") {
+TEST_CASE(
+    "GIVEN the robot slows below the threshold WHEN standing_after_s has passed THEN it stands, and not "
+    "before",
+    "[motion_gate]") {
   MotionGate gate(gateConfig());
   double t = 0.0;
   for (int i = 0; i < 10; ++i) gate.addSample(t += 0.1, 0.03, 0.3);
@@ -61,9 +65,11 @@ TEST_CASE("GIVEN the robot slows below the threshold WHEN standing_after_s has p
   CHECK(gate.at(t).distance_m == Approx(0.33));
 }
 
-TEST_CASE("GIVEN samples stop arriving WHEN timeout_s has passed THEN motion is unknown (link lost), and known again "
-          "after a new sample; the gap restarts the standing run",
-          "[motion_gate]") {
+TEST_CASE(
+    "GIVEN samples stop arriving WHEN timeout_s has passed THEN motion is unknown (link lost), and known "
+    "again "
+    "after a new sample; the gap restarts the standing run",
+    "[motion_gate]") {
   MotionGate gate(gateConfig());
   double t = 0.0;
   for (int i = 0; i < 20; ++i) gate.addSample(t += 0.1, 0.0, 0.0);
@@ -79,7 +85,8 @@ TEST_CASE("GIVEN samples stop arriving WHEN timeout_s has passed THEN motion is 
   CHECK(gate.at(t).standing);
 }
 
-TEST_CASE("GIVEN bad samples WHEN added THEN they are refused and counted, the state unchanged", "[motion_gate]") {
+TEST_CASE("GIVEN bad samples WHEN added THEN they are refused and counted, the state unchanged",
+          "[motion_gate]") {
   MotionGate gate(gateConfig());
   REQUIRE(gate.addSample(1.0, 0.1, 0.3));
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -93,7 +100,8 @@ TEST_CASE("GIVEN bad samples WHEN added THEN they are refused and counted, the s
   CHECK_FALSE(gate.at(nan).known);
 }
 
-TEST_CASE("GIVEN an out-of-range gate config WHEN validated or used THEN the key and range are named", "[motion_gate]") {
+TEST_CASE("GIVEN an out-of-range gate config WHEN validated or used THEN the key and range are named",
+          "[motion_gate]") {
   MotionGateConfig c = gateConfig();
   CHECK(c.validate().empty());
   c.timeout_s = 0.0;

@@ -122,9 +122,10 @@ MotionGateConfig gateConfig() {
 
 }  // namespace
 
-TEST_CASE("GIVEN a route with a long stop WHEN segmented without and with motion THEN the stop makes a spurious "
-          "place only without motion",
-          "[segmentation][motion]") {
+TEST_CASE(
+    "GIVEN a route with a long stop WHEN segmented without and with motion THEN the stop makes a spurious "
+    "place only without motion",
+    "[segmentation][motion]") {
   const int rooms = 4;
   const std::vector<RouteFrame> steady = route(rooms, 0.3, {});
   const std::vector<RouteFrame> stopped = route(rooms, 0.3, {{7.5, 15.0}, {10.5, 15.0}});
@@ -144,9 +145,11 @@ TEST_CASE("GIVEN a route with a long stop WHEN segmented without and with motion
   CHECK(stop_motion.skipped >= 90);
 }
 
-TEST_CASE("GIVEN no motion input WHEN segmented through the motion-aware path THEN the output is bit-identical to the "
-          "time-based segmenter",
-          "[segmentation][motion]") {
+TEST_CASE(
+    "GIVEN no motion input WHEN segmented through the motion-aware path THEN the output is bit-identical to "
+    "the "
+    "time-based segmenter",
+    "[segmentation][motion]") {
   const std::vector<RouteFrame> frames = route(4, 0.3, {{7.5, 15.0}, {10.5, 15.0}});
   FiedlerSegmenterConfig with_distance = timeConfig();
   with_distance.window_m = 1.75;
@@ -168,9 +171,10 @@ TEST_CASE("GIVEN no motion input WHEN segmented through the motion-aware path TH
   CHECK(no_samples.skipped == 0);
 }
 
-TEST_CASE("GIVEN the motion link is lost mid-route WHEN segmented THEN frames after the loss are segmented by time "
-          "and none is skipped",
-          "[segmentation][motion]") {
+TEST_CASE(
+    "GIVEN the motion link is lost mid-route WHEN segmented THEN frames after the loss are segmented by time "
+    "and none is skipped",
+    "[segmentation][motion]") {
   const std::vector<RouteFrame> frames = route(4, 0.3, {{7.5, 15.0}, {10.5, 15.0}});
   FiedlerSegmenterConfig with_distance = timeConfig();
   with_distance.window_m = 1.75;
@@ -183,17 +187,20 @@ TEST_CASE("GIVEN the motion link is lost mid-route WHEN segmented THEN frames af
   CHECK(lost.places.size() == plain.places.size());
 }
 
-TEST_CASE("GIVEN three stops of 10 s and a slow stretch at a third of the speed WHEN segmented with the window in metres THEN the places equal the steady run's",
-          "[segmentation][motion]") {
+TEST_CASE(
+    "GIVEN three stops of 10 s and a slow stretch at a third of the speed WHEN segmented with the window in "
+    "metres THEN the places equal the steady run's",
+    "[segmentation][motion]") {
   const int rooms = 4;
-  const std::vector<RouteFrame> slow = route(rooms, 0.3, {{2.0, 10.0}, {7.5, 10.0}, {10.5, 10.0}}, {13.0, 16.0});
+  const std::vector<RouteFrame> slow =
+      route(rooms, 0.3, {{2.0, 10.0}, {7.5, 10.0}, {10.5, 10.0}}, {13.0, 16.0});
   FiedlerSegmenterConfig with_distance = timeConfig();
   with_distance.window_m = 1.75;
   MotionGate gate(gateConfig());
   const Result motion = segment(slow, with_distance, &gate);
   const Result time_only = segment(slow, timeConfig(), nullptr);
   WARN("three stops and a slow stretch: without motion " << time_only.places.size() << " places, with motion "
-                                                       << motion.places.size());
+                                                         << motion.places.size());
   CHECK(time_only.places.size() > static_cast<std::size_t>(rooms));
   REQUIRE(motion.places.size() == static_cast<std::size_t>(rooms));
   // Each border lies within a metre of a room border.
@@ -203,7 +210,8 @@ TEST_CASE("GIVEN three stops of 10 s and a slow stretch at a third of the speed 
   }
 }
 
-TEST_CASE("GIVEN window_m out of range WHEN validated THEN the key and range are named", "[segmentation][motion]") {
+TEST_CASE("GIVEN window_m out of range WHEN validated THEN the key and range are named",
+          "[segmentation][motion]") {
   FiedlerSegmenterConfig c = timeConfig();
   c.window_m = -0.5;
   CHECK(c.validate().find("window_m") == 0);

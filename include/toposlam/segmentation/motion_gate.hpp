@@ -32,8 +32,8 @@ struct MotionGateConfig {
 
 /// What the gate says about one frame time.
 struct MotionState {
-  bool known = false;     ///< a sample within timeout_s (link alive); false: segment by time as without motion
-  bool standing = false;  ///< known and slower than standing_speed_mps for standing_after_s or more
+  bool known = false;  ///< a sample within timeout_s (link alive); false: segment by time as without motion
+  bool standing = false;    ///< known and slower than standing_speed_mps for standing_after_s or more
   double distance_m = 0.0;  ///< travelled since the first sample (meaningful only when known)
 };
 
