@@ -469,6 +469,9 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       std::snprintf(line, sizeof line, "MOTION #%lld  forward %.3f m  turn %.3f rad", static_cast<long long>(m.sequence),
                     m.forward_m, m.turn_rad);
       out.summary = line;
+      out.motion_time_s = static_cast<double>(m.utime) * 1e-6;
+      out.motion_distance_m = std::hypot(m.forward_m, m.lateral_m);
+      out.motion_speed_mps = std::abs(m.linear_velocity_mps);
     }
   }
   if (!ok) {

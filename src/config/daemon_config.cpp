@@ -294,6 +294,12 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     s.real("window_s", c.segmentation.window_s, 0, 3600, " seconds (0 = a window of `window` frames)");
     s.integer("window", c.segmentation.window, 3, 1000, " frames");
     s.integer("min_window_frames", c.segmentation.min_window_frames, 3, 1000, " frames (and <= window)");
+    s.real("window_m", c.segmentation.window_m, 0, 1000, " metres (0 = off: no window in distance)");
+    Section mo = s.child("motion");
+    mo.real("standing_speed_mps", c.segmentation_motion.standing_speed_mps, 0, 10, " m/s");
+    mo.real("standing_after_s", c.segmentation_motion.standing_after_s, 0, 3600, " seconds");
+    mo.real("timeout_s", c.segmentation_motion.timeout_s, 0, 3600, " seconds", true);
+    mo.finish();
     Section v = s.child("valley");
     v.real("gamma", c.segmentation.valley.gamma, 0, 2, " (and <= window / (window - 1))");
     v.real("delta", c.segmentation.valley.delta, 0, 2, " (and <= gamma)");
@@ -432,6 +438,7 @@ std::string DaemonConfig::validate() const {
   if (std::string p = similarity.validate(); !p.empty()) return prefixed("similarity", p);
 #ifdef TOPOSLAM_HAVE_SEGMENTATION
   if (std::string p = segmentation.validate(); !p.empty()) return prefixed("segmentation", p);
+  if (std::string p = segmentation_motion.validate(); !p.empty()) return prefixed("segmentation.motion", p);
 #endif
 #ifdef TOPOSLAM_HAVE_TOPOLOGY
   if (std::string p = topology.validate(); !p.empty()) return prefixed("topology", p);

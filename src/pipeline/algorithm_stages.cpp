@@ -5,20 +5,57 @@
 #include <map>
 #include <sstream>
 
+#include <spdlog/spdlog.h>
+
 #include "toposlam/topology/map_store.hpp"
 
 namespace toposlam {
 
 FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
-                                                   const SimilarityMeasure& similarity, std::size_t max_thumbnails)
-    : segmenter_(config, similarity), max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)) {}
+                                                   const SimilarityMeasure& similarity, std::size_t max_thumbnails,
+                                                   const MotionGateConfig& motion)
+    : segmenter_(config, similarity), max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)), gate_(motion) {}
 
-SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
+void FiedlerSegmentationStage::addMotion(const MotionSample& sample) {
+  const std::lock_guard<std::mutex> lock(motion_mutex_);
+  if (pending_motion_.size() >= kMaxPendingMotion) {
+    pending_motion_.pop_front();
+    ++dropped_motion_;
+  }
+  pending_motion_.push_back(sample);
+}
+
+std::int64_t FiedlerSegmentationStage::droppedMotionSamples() const {
+  const std::lock_guard<std::mutex> lock(motion_mutex_);
+  return dropped_motion_;
+}
+
+SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double captured_at_s,
+                                                   std::shared_ptr<const Fingerprint> fingerprint,
                                                    const cv::Mat& thumbnail) {
+  {
+    const std::lock_guard<std::mutex> lock(motion_mutex_);
+    applying_.swap(pending_motion_);
+  }
+  for (const MotionSample& m : applying_) gate_.addSample(m.time_s, m.distance_increment_m, m.speed_mps);
+  applying_.clear();
+  const bool was_known = last_motion_.known;
+  last_motion_ = gate_.at(captured_at_s);
+  if (last_motion_.known != was_known) {
+    if (last_motion_.known) {
+      spdlog::info("segmentation: robot motion known; standing frames skipped{}",
+                   segmenter_.config().window_m > 0.0 ? ", window in metres" : "");
+    } else if (gate_.samples() > 0) {
+      spdlog::warn("segmentation: robot motion lost (no sample for {} s); segmenting by time",
+                   gate_.config().timeout_s);
+    }
+  }
   thumbnails_.emplace(sequence, thumbnail);
   if (thumbnails_.size() > max_thumbnails_) thumbnails_.erase(thumbnails_.begin());
-  // The segmenter is independent of time; the frame number stands in for it.
-  SegmenterStep step = segmenter_.addFrame(sequence, static_cast<double>(sequence), std::move(fingerprint));
+  // The segmenter's time is the frame number (toposlamd's frames carry no trustworthy source time; see
+  // docs/segmentation.md); motion is looked up at the pipeline clock, the clock of motion_t.utime.
+  SegmenterStep step =
+      segmenter_.addFrame(sequence, static_cast<double>(sequence), std::move(fingerprint), last_motion_);
   SegmentationStep out;
   if (step.lambda2) out.lambda2 = *step.lambda2;
   if (step.closed_place) out.closed = toClosedPlace(*step.closed_place);

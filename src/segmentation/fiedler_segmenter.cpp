@@ -70,6 +70,11 @@ std::string FiedlerSegmenterConfig::validate() const {
     message << "window_s: " << window_s << " s is outside the allowed range [0, 3600] (0 = count frames)";
     return message.str();
   }
+  if (!(window_m >= 0.0 && window_m <= 1000.0)) {
+    std::ostringstream message;
+    message << "window_m: " << window_m << " m is outside the allowed range [0, 1000] (0 = off)";
+    return message.str();
+  }
   if (min_window_frames < 3 || min_window_frames > window) {
     return "min_window_frames: " + std::to_string(min_window_frames) + " is outside the allowed range [3, window = " +
            std::to_string(window) + "]";
@@ -121,6 +126,7 @@ FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const S
   slot_fingerprint_.resize(static_cast<std::size_t>(n));
   slot_frame_.assign(static_cast<std::size_t>(n), -1);
   slot_time_.assign(static_cast<std::size_t>(n), 0.0);
+  slot_distance_.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
   affinity_ = Eigen::MatrixXd::Zero(n, n);
   degree_ = Eigen::VectorXd::Zero(n);
   inv_sqrt_degree_ = Eigen::VectorXd::Zero(n);
@@ -247,6 +253,32 @@ int FiedlerSegmenter::bestSplitPosition() const {
 
 SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s,
                                          std::shared_ptr<const Fingerprint> fingerprint) {
+  return addFrameAt(frame_index, time_s, std::move(fingerprint), std::numeric_limits<double>::quiet_NaN());
+}
+
+SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s,
+                                         std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
+  if (!motion.known) return addFrame(frame_index, time_s, std::move(fingerprint));
+  if (motion.standing) {
+    if (!fingerprint) throw std::invalid_argument("FiedlerSegmenter::addFrame: null fingerprint");
+    if (frame_index <= last_frame_) {
+      throw std::invalid_argument("FiedlerSegmenter::addFrame: frame " + std::to_string(frame_index) +
+                                  " does not follow frame " + std::to_string(last_frame_) +
+                                  " (frame indices must increase)");
+    }
+    ++skipped_frames_;
+    SegmenterStep step;
+    step.frame = frame_index;
+    step.skipped = true;
+    return step;
+  }
+  const double distance_m =
+      std::isfinite(motion.distance_m) ? motion.distance_m : std::numeric_limits<double>::quiet_NaN();
+  return addFrameAt(frame_index, time_s, std::move(fingerprint), distance_m);
+}
+
+SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time_s,
+                                           std::shared_ptr<const Fingerprint> fingerprint, double distance_m) {
   if (!fingerprint) throw std::invalid_argument("FiedlerSegmenter::addFrame: null fingerprint");
   if (frame_index <= last_frame_) {
     throw std::invalid_argument("FiedlerSegmenter::addFrame: frame " + std::to_string(frame_index) +
@@ -268,7 +300,24 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
   }
   // A window in time: frames taken window_s or more before this one leave (keeping min_window_frames).
   // A clock that goes back (a new traversal) leaves them all in: only the ring's size then evicts.
-  if (config_.window_s > 0.0) {
+  // A window in distance (motion known for this frame): frames taken window_m or more of travel before
+  // this one leave; an older frame without a distance (taken while motion was unknown) leaves by time.
+  const bool by_distance = config_.window_m > 0.0 && std::isfinite(distance_m);
+  if (by_distance) {
+    const double tolerance_m = 1e-6 * config_.window_m;
+    const double tolerance_s = 1e-6 * config_.window_s;
+    while (count_ >= config_.min_window_frames) {
+      const auto oldest = static_cast<std::size_t>(slotAtPosition(0));
+      const double oldest_distance = slot_distance_[oldest];
+      if (std::isfinite(oldest_distance)) {
+        if (!(distance_m - oldest_distance >= config_.window_m - tolerance_m)) break;
+      } else if (!(config_.window_s > 0.0 && time_s - slot_time_[oldest] >= config_.window_s - tolerance_s)) {
+        break;
+      }
+      --count_;
+      window_full_ = true;
+    }
+  } else if (config_.window_s > 0.0) {
     const double tolerance = 1e-6 * config_.window_s;
     while (count_ >= config_.min_window_frames) {
       const double oldest_time = slot_time_[static_cast<std::size_t>(slotAtPosition(0))];
@@ -282,6 +331,7 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
   slot_fingerprint_[s] = std::move(fingerprint);
   slot_frame_[s] = frame_index;
   slot_time_[s] = time_s;
+  slot_distance_[s] = distance_m;
   // Only the new frame's row and column are new: 2 (k-1) similarity calls. Slots outside the window
   // are never read, so their rows are not cleared.
   affinity_(slot, slot) = 0.0;

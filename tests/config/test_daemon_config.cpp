@@ -71,6 +71,11 @@ SCENARIO("The shipped config documents the defaults in code") {
       CHECK(shipped.segmentation.window == defaults.segmentation.window);
       CHECK(shipped.segmentation.window_s == defaults.segmentation.window_s);
       CHECK(shipped.segmentation.min_window_frames == defaults.segmentation.min_window_frames);
+      CHECK(shipped.segmentation.window_m == defaults.segmentation.window_m);
+      CHECK(shipped.segmentation.window_m == 0.0);
+      CHECK(shipped.segmentation_motion.standing_speed_mps == defaults.segmentation_motion.standing_speed_mps);
+      CHECK(shipped.segmentation_motion.standing_after_s == defaults.segmentation_motion.standing_after_s);
+      CHECK(shipped.segmentation_motion.timeout_s == defaults.segmentation_motion.timeout_s);
       CHECK(shipped.preset == defaults.preset);
       CHECK(shipped.similarity.matcher.mutual_check == defaults.similarity.matcher.mutual_check);
       CHECK(shipped.similarity.matcher.max_angle_difference_deg == defaults.similarity.matcher.max_angle_difference_deg);
@@ -175,6 +180,10 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"segmentation: {valley: {gamma: 0.2, delta: 0.3}}", "segmentation.valley.delta: 0.3 is out of range, allowed [0, gamma = 0.2]"},
       {"segmentation: {window: 3, valley: {gamma: 1.6}}", "segmentation.valley.gamma: 1.6 is out of range, allowed [0, window / (window - 1) = 1.5]"},
       {"segmentation: {cut_placement: middle}", "segmentation.cut_placement: 'middle' is not allowed"},
+      {"segmentation: {window_m: -1}", "segmentation.window_m: -1 is out of range, allowed [0, 1000] metres"},
+      {"segmentation: {motion: {timeout_s: 0}}", "segmentation.motion.timeout_s: 0 is out of range, allowed (0, 3600] seconds"},
+      {"segmentation: {motion: {standing_speed_mps: 11}}", "segmentation.motion.standing_speed_mps: 11 is out of range"},
+      {"segmentation: {motion: {stand: 1}}", "unknown key 'segmentation.motion.stand'"},
       {"topology: {particles: 0}", "topology.particles: 0 is out of range, allowed 1 .. 1000000"},
       {"topology: {particles: lots}", "topology.particles: expected an integer in 1 .. 1000000, got 'lots'"},
       {"topology: {new_node_probability: 1}", "topology.new_node_probability: 1 is out of range, allowed (0, 1)"},

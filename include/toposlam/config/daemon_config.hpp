@@ -48,6 +48,7 @@ struct DaemonConfig {
   VpackConfig fingerprint;
   NgramSimilarityConfig similarity;
   FiedlerSegmenterConfig segmentation;
+  MotionGateConfig segmentation_motion;  ///< segmentation.motion: when TOPOSLAM_MOTION says the robot stands
   TopologyFilterConfig topology;
   int topology_slice_items = 256;  ///< topology.slice_items: work items per advance() slice, 1 .. 1000000
   int topology_alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16

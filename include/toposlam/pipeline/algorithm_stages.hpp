@@ -7,6 +7,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,17 +33,39 @@ class VpackFingerprintStage final : public FingerprintStage {
   VpackExtractor extractor_;
 };
 
+/// One robot motion sample for the segmentation stage (from TOPOSLAM_MOTION's motion_t).
+struct MotionSample {
+  double time_s = 0.0;                ///< pipeline clock (CLOCK_MONOTONIC seconds: motion_t.utime / 1e6)
+  double distance_increment_m = 0.0;  ///< travelled since the previous sample
+  double speed_mps = 0.0;
+};
+
 /// FiedlerSegmenter. Keeps the thumbnails of the open place's frames (at most `max_thumbnails`, oldest
 /// dropped) so the closed place's representative has its picture. Dropped places (too few keypoints) are
 /// counted and not passed on.
+///
+/// Motion (docs/segmentation.md, "Motion-aware segmentation"): samples given to addMotion() (any thread)
+/// are applied to a MotionGate, in order, before the next frame; each frame then asks the gate at its
+/// captured_at_s. Without samples the segmentation is exactly the one without motion.
 class FiedlerSegmentationStage final : public SegmentationStage {
  public:
   FiedlerSegmentationStage(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity,
-                           std::size_t max_thumbnails = 600);
-  SegmentationStep process(std::int64_t sequence, std::shared_ptr<const Fingerprint> fingerprint,
+                           std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {});
+  SegmentationStep process(std::int64_t sequence, double captured_at_s, std::shared_ptr<const Fingerprint> fingerprint,
                            const cv::Mat& thumbnail) override;
   std::optional<ClosedPlace> finish() override;
   std::int64_t droppedPlaces() const { return dropped_places_; }
+
+  /// Any thread. Queues a sample for the segmentation thread; at most kMaxPendingMotion wait (beyond,
+  /// the oldest is dropped and counted in droppedMotionSamples()).
+  void addMotion(const MotionSample& sample);
+  static constexpr std::size_t kMaxPendingMotion = 4096;
+  /// Segmentation thread (or after it ended): the gate's state at the last frame, frames skipped as
+  /// standing, samples the gate refused (time going back, not finite) or that overflowed the queue.
+  MotionState lastMotion() const { return last_motion_; }
+  std::int64_t skippedFrames() const { return segmenter_.skippedFrames(); }
+  std::int64_t refusedMotionSamples() const { return gate_.rejectedSamples(); }
+  std::int64_t droppedMotionSamples() const;
 
  private:
   /// The pipeline's record of a place the segmenter closed (nullopt when it was dropped); frees the
@@ -53,6 +76,13 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::size_t max_thumbnails_;
   std::map<std::int64_t, cv::Mat> thumbnails_;  ///< frame -> thumbnail, frames of the open place
   std::int64_t dropped_places_ = 0;
+
+  MotionGate gate_;
+  MotionState last_motion_;
+  mutable std::mutex motion_mutex_;
+  std::deque<MotionSample> pending_motion_;  ///< guarded by motion_mutex_
+  std::deque<MotionSample> applying_;        ///< segmentation thread: swapped out of pending_motion_
+  std::int64_t dropped_motion_ = 0;          ///< guarded by motion_mutex_
 };
 
 /// TopologyParticleFilter with its step sliced into `slice_items` work items, run until the time budget

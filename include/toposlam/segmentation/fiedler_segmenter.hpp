@@ -48,6 +48,7 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/segmentation/motion_gate.hpp"
 #include "toposlam/segmentation/valley_detector.hpp"
 
 namespace toposlam {
@@ -69,8 +70,15 @@ struct FiedlerSegmenterConfig {
   /// With window_s = 0: frames in the window, allowed [3, 1000]; thesis 25, ours 30 with delta 0.30
   /// (docs/segmentation.md, "Defaults"). With window_s > 0: the most frames the window may hold.
   int window = 30;
-  /// With window_s > 0: the fewest frames the window keeps however long they took; allowed [3, window].
+  /// With window_s > 0 or window_m > 0: the fewest frames the window keeps however long (or far) they
+  /// took; allowed [3, window].
   int min_window_frames = 5;
+  /// Motion-aware segmentation (docs/segmentation.md, "Motion-aware segmentation"): for frames added with
+  /// a known MotionState, the window holds the frames taken less than window_m metres of travel before
+  /// the newest one (within min_window_frames .. window), at any speed. Frames without known motion (no
+  /// motion input, or the link lost) fall back to window_s / window. Allowed [0, 1000]; 0 = off (thesis
+  /// suggests about 1.5 - 1.75 m).
+  double window_m = 0.0;
   /// Subtracted from every similarity before it enters the affinity matrix (clamped at 0), so frames
   /// of different places, which still match ~0.15 by colour, become unlinked. Allowed [0, 1).
   double similarity_floor = 0.0;
@@ -111,6 +119,7 @@ struct SegmenterStep {
   std::int64_t frame = 0;
   std::optional<double> lambda2;               ///< empty while the window holds one frame
   std::optional<SegmentedPlace> closed_place;  ///< a place closed by a valley confirmed at this frame
+  bool skipped = false;  ///< motion said the robot stands: the frame was not added (no lambda2)
 };
 
 class FiedlerSegmenter {
@@ -122,6 +131,11 @@ class FiedlerSegmenter {
   /// std::invalid_argument otherwise or when `fingerprint` is null.
   SegmenterStep addFrame(std::int64_t frame_index, double time_s,
                          std::shared_ptr<const Fingerprint> fingerprint);
+  /// Motion-aware: with motion.known and motion.standing, the frame is not added (step.skipped; nothing
+  /// changes but the skipped count); with motion.known and window_m > 0 the window is sized by
+  /// motion.distance_m. With !motion.known, exactly addFrame(frame_index, time_s, fingerprint).
+  SegmenterStep addFrame(std::int64_t frame_index, double time_s, std::shared_ptr<const Fingerprint> fingerprint,
+                         const MotionState& motion);
 
   /// End of stream: closes the open place (if it has frames) and returns it. Frames added afterwards
   /// start a new place; the window and the detector keep their state.
@@ -130,13 +144,15 @@ class FiedlerSegmenter {
   const FiedlerSegmenterConfig& config() const { return config_; }
   /// Frames currently in the window (<= config().window).
   int windowFrames() const { return count_; }
-  /// True once the window spans its full length (window_s, or `window` frames): lambda2 goes to the
+  /// True once the window spans its full length (window_m, window_s, or `window` frames): lambda2 goes to the
   /// valley detector only from then on.
   bool windowFull() const { return window_full_; }
   /// First frame of the open place, or -1 before any frame.
   std::int64_t openPlaceStart() const { return place_start_; }
   /// Valleys that could not close a place (their best split fell before the open place started).
   std::int64_t ignoredValleys() const { return ignored_valleys_; }
+  /// Frames left out because motion said the robot stood.
+  std::int64_t skippedFrames() const { return skipped_frames_; }
   /// Current cached affinity matrix, rows/columns in window order (oldest first); for tests and plots.
   Eigen::MatrixXd affinityInWindowOrder() const;
 
@@ -151,6 +167,9 @@ class FiedlerSegmenter {
   /// The representative preference of the header comment: true when `a` is the better candidate.
   bool preferred(const Candidate& a, const Candidate& b) const;
 
+  /// addFrame with the distance travelled at the frame (NaN = motion unknown).
+  SegmenterStep addFrameAt(std::int64_t frame_index, double time_s, std::shared_ptr<const Fingerprint> fingerprint,
+                           double distance_m);
   int slotAtPosition(int position) const;  ///< window position 0 = oldest frame
   double computeLambda2();
   /// Remembers the window frame with the largest degree among frames in [from_frame, before_frame).
@@ -175,6 +194,7 @@ class FiedlerSegmenter {
   std::vector<std::shared_ptr<const Fingerprint>> slot_fingerprint_;
   std::vector<std::int64_t> slot_frame_;
   std::vector<double> slot_time_;
+  std::vector<double> slot_distance_;  ///< metres travelled at the frame; NaN = motion unknown
   Eigen::MatrixXd affinity_;  ///< n x n, symmetric, zero diagonal; rows of empty slots are 0
   Eigen::VectorXd degree_;    ///< n
   Eigen::VectorXd inv_sqrt_degree_;
@@ -197,6 +217,7 @@ class FiedlerSegmenter {
   std::int64_t kept_places_ = 0;
   std::int64_t dropped_places_ = 0;
   std::int64_t ignored_valleys_ = 0;
+  std::int64_t skipped_frames_ = 0;
 };
 
 }  // namespace toposlam

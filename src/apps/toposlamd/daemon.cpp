@@ -90,7 +90,8 @@ struct Assembly {
     pool = std::make_unique<WorkerPool>(config.fingerprint_workers, "tsl-vpack");
     fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get());
     similarity = std::make_unique<NgramSimilarity>(config.similarity);
-    segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity);
+    segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity, 600,
+                                                               config.segmentation_motion);
     topology = std::make_unique<ParticleFilterTopologyStage>(config.topology, *similarity, clock,
                                                              config.topology_slice_items, config.topology_alternatives);
   }
@@ -153,12 +154,16 @@ int runDaemon(const DaemonConfig& config) {
     }
   }
 
-  // Motion input: counted (the filter does not use odometry yet; see docs/daemon.md).
+  // Motion input: counted, and fed to the segmentation's MotionGate (docs/segmentation.md, "Motion-aware
+  // segmentation"; motion_t.utime and the pipeline's SteadyClock are both CLOCK_MONOTONIC).
   std::atomic<std::int64_t> motion_messages{0};
   std::atomic<bool> receiving{true};
   const LcmChannels channels = channelsOf(config.lcm);
-  LcmSubscriber motion(config.lcm.url, channels, {channels.motion},
-                       [&](const ReceivedMessage&) { motion_messages.fetch_add(1); });
+  FiedlerSegmentationStage& segmentation_stage = *parts.segmentation;
+  LcmSubscriber motion(config.lcm.url, channels, {channels.motion}, [&](const ReceivedMessage& m) {
+    motion_messages.fetch_add(1);
+    segmentation_stage.addMotion(MotionSample{m.motion_time_s, m.motion_distance_m, m.motion_speed_mps});
+  });
   LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_messages);
 
   Pipeline pipeline(pipeline_config, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink,

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -76,6 +77,11 @@ struct ReceivedMessage {
   int node = -1;            ///< place and place_event: the node
   int place = -1;
   bool is_new = false;
+  // motion messages: motion_t.utime in seconds (host CLOCK_MONOTONIC), hypot(forward_m, lateral_m) and
+  // |linear_velocity_mps|; time NaN for other kinds.
+  double motion_time_s = std::numeric_limits<double>::quiet_NaN();
+  double motion_distance_m = 0.0;
+  double motion_speed_mps = 0.0;
 };
 
 /// True when every array length field of an encoded message of `kind` (place, place_event, status,

@@ -1,0 +1,67 @@
+// The robot's own motion for segmentation (thesis sections 4.4 and 6.3; docs/segmentation.md,
+// "Motion-aware segmentation"). Fed with motion samples (time, distance travelled since the previous
+// sample, speed), e.g. decoded from TOPOSLAM_MOTION, it answers per frame time:
+//   known     a sample arrived within `timeout_s` of the frame (the link is alive);
+//   standing  known, and every sample for at least `standing_after_s` up to now had a speed below
+//             `standing_speed_mps` (a short halt, e.g. a turn on the spot's first moment, is not a stop);
+//   distance  the distance travelled so far (sum of |increment|; reversing counts as travel).
+// The FiedlerSegmenter then leaves standing frames out of its window and, with segmentation.window_m > 0,
+// sizes the window in metres (FiedlerSegmenter::addFrame with a MotionState).
+//
+// Plain algorithm code: no clock, no threads; times are whatever clock the caller uses for both the
+// samples and the frames (seconds). Samples must come in time order: one older than the newest, or with a
+// non-finite value, is refused and counted. A gap in the samples longer than `timeout_s` restarts the
+// standing run. Not thread-safe: one instance per stream, fed by its one thread. Does not allocate.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace toposlam {
+
+struct MotionGateConfig {
+  /// Slower than this (absolute speed, m/s) counts as standing; allowed [0, 10].
+  double standing_speed_mps = 0.05;
+  /// The robot stands once it has been slower than standing_speed_mps for this long, seconds; [0, 3600].
+  double standing_after_s = 1.0;
+  /// Motion is known while the newest sample is at most this old at the frame's time, seconds; (0, 3600].
+  double timeout_s = 1.0;
+  /// Returns "" when valid, else "<key>: <problem, allowed range>".
+  std::string validate() const;
+};
+
+/// What the gate says about one frame time.
+struct MotionState {
+  bool known = false;  ///< a sample within timeout_s (link alive); false: segment by time as without motion
+  bool standing = false;    ///< known and slower than standing_speed_mps for standing_after_s or more
+  double distance_m = 0.0;  ///< travelled since the first sample (meaningful only when known)
+};
+
+class MotionGate {
+ public:
+  /// Throws std::invalid_argument on an invalid config.
+  explicit MotionGate(const MotionGateConfig& config);
+
+  /// One motion sample: `distance_increment_m` travelled since the previous sample, current `speed_mps`.
+  /// Returns false (and counts it in rejectedSamples()) when time goes back or a value is not finite.
+  bool addSample(double time_s, double distance_increment_m, double speed_mps);
+
+  /// The state at a frame taken at `time_s` (from the samples added so far).
+  MotionState at(double time_s) const;
+
+  const MotionGateConfig& config() const { return config_; }
+  std::int64_t samples() const { return samples_; }
+  std::int64_t rejectedSamples() const { return rejected_; }
+  double distanceM() const { return distance_m_; }
+
+ private:
+  MotionGateConfig config_;
+  std::int64_t samples_ = 0;
+  std::int64_t rejected_ = 0;
+  double last_time_s_ = 0.0;
+  double distance_m_ = 0.0;
+  bool slow_ = false;          ///< the newest sample was below standing_speed_mps
+  double slow_since_s_ = 0.0;  ///< time of the first sample of the current slow run
+};
+
+}  // namespace toposlam

@@ -1,0 +1,53 @@
+// MotionGate; see the header.
+#include "toposlam/segmentation/motion_gate.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace toposlam {
+
+std::string MotionGateConfig::validate() const {
+  std::ostringstream message;
+  if (!(standing_speed_mps >= 0.0 && standing_speed_mps <= 10.0)) {
+    message << "standing_speed_mps: " << standing_speed_mps << " m/s is outside the allowed range [0, 10]";
+  } else if (!(standing_after_s >= 0.0 && standing_after_s <= 3600.0)) {
+    message << "standing_after_s: " << standing_after_s << " s is outside the allowed range [0, 3600]";
+  } else if (!(timeout_s > 0.0 && timeout_s <= 3600.0)) {
+    message << "timeout_s: " << timeout_s << " s is outside the allowed range (0, 3600]";
+  }
+  return message.str();
+}
+
+MotionGate::MotionGate(const MotionGateConfig& config) : config_(config) {
+  if (const std::string problem = config_.validate(); !problem.empty()) {
+    throw std::invalid_argument("motion gate config: " + problem);
+  }
+}
+
+bool MotionGate::addSample(double time_s, double distance_increment_m, double speed_mps) {
+  if (!std::isfinite(time_s) || !std::isfinite(distance_increment_m) || !std::isfinite(speed_mps) ||
+      (samples_ > 0 && time_s < last_time_s_)) {
+    ++rejected_;
+    return false;
+  }
+  const bool gap = samples_ > 0 && time_s - last_time_s_ > config_.timeout_s;
+  const bool slow = std::abs(speed_mps) < config_.standing_speed_mps;
+  if (slow && (!slow_ || gap || samples_ == 0)) slow_since_s_ = time_s;
+  slow_ = slow;
+  distance_m_ += std::abs(distance_increment_m);
+  last_time_s_ = time_s;
+  ++samples_;
+  return true;
+}
+
+MotionState MotionGate::at(double time_s) const {
+  MotionState state;
+  if (samples_ == 0 || !std::isfinite(time_s) || time_s - last_time_s_ > config_.timeout_s) return state;
+  state.known = true;
+  state.distance_m = distance_m_;
+  state.standing = slow_ && time_s - slow_since_s_ >= config_.standing_after_s;
+  return state;
+}
+
+}  // namespace toposlam
