@@ -2,6 +2,7 @@
 #include "toposlam/pipeline/algorithm_stages.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <sstream>
 
@@ -30,7 +31,7 @@ std::int64_t FiedlerSegmentationStage::droppedMotionSamples() const {
   return dropped_motion_;
 }
 
-SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double captured_at_s,
+SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double source_time_s, double captured_at_s,
                                                    std::shared_ptr<const Fingerprint> fingerprint,
                                                    const cv::Mat& thumbnail) {
   {
@@ -52,10 +53,15 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   }
   thumbnails_.emplace(sequence, thumbnail);
   if (thumbnails_.size() > max_thumbnails_) thumbnails_.erase(thumbnails_.begin());
-  // The segmenter's time is the frame number (toposlamd's frames carry no trustworthy source time; see
-  // docs/segmentation.md); motion is looked up at the pipeline clock, the clock of motion_t.utime.
-  SegmenterStep step =
-      segmenter_.addFrame(sequence, static_cast<double>(sequence), std::move(fingerprint), last_motion_);
+  // The window's clock is the frame's source time (a window in seconds of the world, also when a file or
+  // the simulator plays faster than real time); motion is looked up at the pipeline clock, the clock of
+  // motion_t.utime. A source time that does not increase (a source without timestamps) falls back to
+  // the frame number, so the window still moves.
+  double time_s = source_time_s;
+  if (!(std::isfinite(time_s) && time_s > last_source_time_s_))
+    time_s = std::isfinite(last_source_time_s_) ? last_source_time_s_ + 1.0 : 0.0;
+  last_source_time_s_ = time_s;
+  SegmenterStep step = segmenter_.addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   SegmentationStep out;
   if (step.lambda2) out.lambda2 = *step.lambda2;
   if (step.closed_place) out.closed = toClosedPlace(*step.closed_place);

@@ -316,7 +316,8 @@ void Pipeline::segmentationLoop() {
       }
       if (wait == QueueWait::Timeout) continue;
       const double t0 = clock_.now();
-      SegmentationStep step = segmentation_.process(in.result.sequence, in.result.captured_at_s, std::move(in.fingerprint),
+      SegmentationStep step = segmentation_.process(in.result.sequence, in.result.source_time_s, in.result.captured_at_s,
+                                                       std::move(in.fingerprint),
                                                        in.thumbnail);
       in.result.lambda2 = step.lambda2;
       if (step.closed) in.result.closed_place = std::move(step.closed);

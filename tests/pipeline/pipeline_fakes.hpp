@@ -125,7 +125,7 @@ class FakeFingerprint final : public FingerprintStage {
 class FakeSegmentation final : public SegmentationStage {
  public:
   explicit FakeSegmentation(int period) : period_(period) {}
-  SegmentationStep process(std::int64_t sequence, double /*captured_at_s*/,
+  SegmentationStep process(std::int64_t sequence, double /*source_time_s*/, double /*captured_at_s*/,
                            std::shared_ptr<const Fingerprint> fingerprint, const cv::Mat& thumbnail) override {
     if (throw_at >= 0 && sequence == throw_at) throw std::runtime_error("boom");
     if (after_frame) after_frame(sequence);

@@ -38,7 +38,7 @@ TEST_CASE(
   FiedlerSegmenter plain(stageConfig(), similarity);
   int closed = 0, plain_closed = 0;
   for (int f = 0; f < 120; ++f) {
-    const auto step = stage.process(f, 100.0 + 0.2 * f, fakeFingerprint(f), cv::Mat());
+    const auto step = stage.process(f, static_cast<double>(f), 100.0 + 0.2 * f, fakeFingerprint(f), cv::Mat());
     const auto expected = plain.addFrame(f, static_cast<double>(f), fakeFingerprint(f));
     REQUIRE(std::isnan(step.lambda2) == !expected.lambda2.has_value());
     if (expected.lambda2) REQUIRE(step.lambda2 == *expected.lambda2);
@@ -66,7 +66,7 @@ TEST_CASE(
   feeder.join();
   for (int f = 0; f < 30; ++f) {
     const double t = 100.0 + 0.2 * f;  // 100 .. 105.8 s
-    const auto step = stage.process(f, t, fakeFingerprint(f), cv::Mat());
+    const auto step = stage.process(f, t, t, fakeFingerprint(f), cv::Mat());
     if (t >= 101.0 && t <= 105.5) {
       CHECK(stage.lastMotion().standing);
       CHECK(std::isnan(step.lambda2));
@@ -76,7 +76,7 @@ TEST_CASE(
   CHECK_FALSE(stage.lastMotion().known);  // 105.8 s: the newest sample is 0.8 s old
   CHECK(stage.refusedMotionSamples() == 0);
   stage.addMotion(MotionSample{50.0, 0.0, 0.0});  // back in time: refused by the gate
-  stage.process(30, 106.0, fakeFingerprint(30), cv::Mat());
+  stage.process(30, 106.0, 106.0, fakeFingerprint(30), cv::Mat());
   CHECK(stage.refusedMotionSamples() == 1);
 }
 
@@ -89,7 +89,7 @@ TEST_CASE(
   const auto n = static_cast<int>(FiedlerSegmentationStage::kMaxPendingMotion) + 10;
   for (int i = 0; i < n; ++i) stage.addMotion(MotionSample{0.01 * i, 0.001, 0.1});
   CHECK(stage.droppedMotionSamples() == 10);
-  stage.process(0, 0.01 * n, fakeFingerprint(0), cv::Mat());
+  stage.process(0, 0.0, 0.01 * n, fakeFingerprint(0), cv::Mat());
   CHECK(stage.lastMotion().known);
   CHECK(stage.lastMotion().distance_m ==
         Approx(0.001 * static_cast<double>(FiedlerSegmentationStage::kMaxPendingMotion)));

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -51,7 +52,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
  public:
   FiedlerSegmentationStage(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity,
                            std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {});
-  SegmentationStep process(std::int64_t sequence, double captured_at_s, std::shared_ptr<const Fingerprint> fingerprint,
+  SegmentationStep process(std::int64_t sequence, double source_time_s, double captured_at_s, std::shared_ptr<const Fingerprint> fingerprint,
                            const cv::Mat& thumbnail) override;
   std::optional<ClosedPlace> finish() override;
   std::int64_t droppedPlaces() const { return dropped_places_; }
@@ -79,6 +80,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 
   MotionGate gate_;
   MotionState last_motion_;
+  double last_source_time_s_ = -std::numeric_limits<double>::infinity();  ///< the window's clock so far
   mutable std::mutex motion_mutex_;
   std::deque<MotionSample> pending_motion_;  ///< guarded by motion_mutex_
   std::deque<MotionSample> applying_;        ///< segmentation thread: swapped out of pending_motion_

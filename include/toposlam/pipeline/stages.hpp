@@ -99,7 +99,9 @@ class SegmentationStage {
   /// `thumbnail` is the frame's small image (for the place event of the place it may end up
   /// representing); the stage may keep it (cv::Mat shares, no copy). `captured_at_s` is the pipeline
   /// clock when the frame left the source (FrameResult::captured_at_s; the daemon's is CLOCK_MONOTONIC).
-  virtual SegmentationStep process(std::int64_t sequence, double captured_at_s,
+  /// source_time_s: the frame's time from its source (capture time, the simulator's clock, image
+  /// timestamps), the segmentation window's clock; captured_at_s: the pipeline clock, motion's.
+  virtual SegmentationStep process(std::int64_t sequence, double source_time_s, double captured_at_s,
                                    std::shared_ptr<const Fingerprint> fingerprint, const cv::Mat& thumbnail) = 0;
   /// Called once when the stream has ended (not on a stop request, after which a resumed run goes on
   /// in the same place): closes the open place, if it is kept.
