@@ -2,43 +2,18 @@
 // $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
 // runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
 #include <csignal>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <iostream>
 #include <string>
-#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
 #include "sources.hpp"
+#include "toposlam/config/config_path.hpp"
 #include "toposlam/config/daemon_config.hpp"
-
-namespace {
-
-#ifndef TOPOSLAM_INSTALLED_CONFIG
-#define TOPOSLAM_INSTALLED_CONFIG "/etc/toposlam/toposlam.yaml"
-#endif
-
-// $CONFIGURATION_DIRECTORY/toposlam.yaml (systemd ConfigurationDirectory=), then /etc/toposlam/toposlam.yaml,
-// then the copy `cmake --install` put under the install prefix; the first that exists wins.
-std::string defaultConfigPath() {
-  std::vector<std::string> candidates;
-  if (const char* dir = std::getenv("CONFIGURATION_DIRECTORY"); dir != nullptr && dir[0] != '\0') {
-    std::string first(dir);
-    first = first.substr(0, first.find(':'));
-    candidates.push_back((std::filesystem::path(first) / "toposlam.yaml").string());
-  }
-  candidates.push_back("/etc/toposlam/toposlam.yaml");
-  candidates.push_back(TOPOSLAM_INSTALLED_CONFIG);
-  for (const std::string& c : candidates)
-    if (std::filesystem::exists(c)) return c;
-  return candidates.front();
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
@@ -51,7 +26,7 @@ int main(int argc, char** argv) {
   double save_period = -1.0;
   toposlam::daemon::BenchOptions bench_options;
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
-                                                 defaultConfigPath() + " if it exists, else built-in defaults");
+                                                 toposlam::defaultDaemonConfigPath() + " if it exists, else built-in defaults");
   app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
   auto* map_option = app.add_option("--map", map_path,
                                     "override `map.path` (relative paths resolve against $STATE_DIRECTORY; \"\" = never saved)");
@@ -67,7 +42,7 @@ int main(int argc, char** argv) {
   try {
     toposlam::DaemonConfig config;
     const bool explicit_config = !config_path.empty();
-    if (!explicit_config) config_path = defaultConfigPath();
+    if (!explicit_config) config_path = toposlam::defaultDaemonConfigPath();
     if (explicit_config || std::filesystem::exists(config_path)) {
       config = toposlam::loadDaemonConfig(config_path);
     } else {
