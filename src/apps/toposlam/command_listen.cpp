@@ -116,7 +116,7 @@ void addListenCommand(CLI::App& app) {
                   "comma-separated channels, by name or by config key: place, place_event, topology, status, motion "
                   "(default: place,place_event)");
   cmd->add_option("--count", options->count, "stop after N messages (0 = no limit)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--timeout", options->timeout_s, "stop after S seconds (0 = no limit); exit code 3 if nothing arrived")
+  cmd->add_option("--timeout", options->timeout_s, "stop after S seconds (0 = no limit); exit status 1 if nothing arrived")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", options->json, "one JSON object per line");
   cmd->add_flag("--hz", options->hz, "at the end, print each channel's message count and rate (messages per second)");
@@ -170,9 +170,10 @@ void addListenCommand(CLI::App& app) {
     if (subscriber.malformed() > 0)
       std::cerr << "toposlam listen: " << subscriber.malformed() << " messages could not be decoded\n";
     if (printed == 0 && options->timeout_s > 0 && g_interrupted == 0) {
-      std::cerr << "toposlam listen: no message within " << options->timeout_s << " s on " << url
-                << " (is toposlamd running? same lcm.url and multicast route?)\n";
-      throw CLI::RuntimeError(3);
+      std::ostringstream message;
+      message << "listen: no message within " << options->timeout_s << " s on " << url
+              << " (is toposlamd running? same lcm.url and multicast route?)";
+      throw std::runtime_error(message.str());
     }
   });
 }

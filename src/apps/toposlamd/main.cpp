@@ -14,7 +14,21 @@
 #include "sources.hpp"
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/config/daemon_config.hpp"
+#include "toposlam/io/frame_source.hpp"
+#include "toposlam/topology/map_store.hpp"
 
+namespace {
+
+int startError(const std::exception& e, int code) {
+  std::cerr << "toposlamd: error: " << e.what() << "\n";
+  return code;
+}
+
+}  // namespace
+
+// Exit status: 0 ok (end of stream or a stop signal), 1 runtime error (LCM, the pipeline failed), 2 usage or
+// config error: a bad option, config, source or map that no restart fixes (the unit's
+// RestartPreventExitStatus=2).
 int main(int argc, char** argv) {
   // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
@@ -37,7 +51,12 @@ int main(int argc, char** argv) {
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
   app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
   app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints the help, the version or the usage error
+    return code == 0 ? 0 : 2;      // CLI11's own codes (105-109, ...) are usage errors: 2
+  }
 
   try {
     toposlam::DaemonConfig config;
@@ -69,8 +88,13 @@ int main(int argc, char** argv) {
       return toposlam::daemon::runBench(config, bench_options);
     }
     return toposlam::daemon::runDaemon(config);
+  } catch (const toposlam::ConfigError& e) {
+    return startError(e, 2);
+  } catch (const toposlam::FrameSourceError& e) {
+    return startError(e, 2);  // the configured source cannot be opened as given (URI, path, permissions)
+  } catch (const toposlam::MapStoreError& e) {
+    return startError(e, 2);  // the map is locked by another process, too large, or made with other settings
   } catch (const std::exception& e) {
-    std::cerr << "toposlamd: error: " << e.what() << "\n";
-    return 2;
+    return startError(e, 1);  // e.g. LCM cannot open yet (no network, no multicast route): a restart may help
   }
 }
