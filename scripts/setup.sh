@@ -1,16 +1,42 @@
 #!/usr/bin/env bash
-# Installs every Debian package toposlam needs to build, test and run. Idempotent; needs root (or sudo).
+# Installs the Debian packages toposlam needs. Idempotent; needs root (or sudo).
+#   scripts/setup.sh          build + run: what scripts/build.sh and scripts/run-demo.sh need
+#   scripts/setup.sh --test   also the test-only tools (browser check, VM camera test): scripts/test.sh, CI
+#   scripts/setup.sh [--test] --print   print the package list, one a line, and install nothing
 set -euo pipefail
 
-PACKAGES=(
+# To build (scripts/build.sh builds the test suite too, so Catch2's headers are a build dependency).
+BUILD_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
-  graphviz
+)
+# To run toposlam, toposlamd and the demo.
+RUNTIME_PACKAGES=(
+  graphviz   # `dot`: the topology drawing of `toposlam map`
+  iproute2   # `ip`: the demo's private network namespace with multicast on loopback; the multicast route
+)
+# Only for tests.
+TEST_PACKAGES=(
   chromium chromium-driver python3  # browser check of `toposlam report` over WebDriver (ctest -L browser)
-  qemu-system-x86 busybox-static cpio kmod xz-utils v4l-utils ffmpeg iproute2  # VM camera test (tests/vm)
+  qemu-system-x86 busybox-static cpio kmod xz-utils v4l-utils ffmpeg  # VM camera test (tests/vm)
   libcamera-ipa libcamera-tools  # VM test: libcamera's vimc IPA module, `cam --list` (tests/vm)
 )
+
+with_tests=0
+print_only=0
+for arg in "$@"; do
+  case "$arg" in
+    --test) with_tests=1 ;;
+    --print) print_only=1 ;;
+    -h|--help) sed -n '2,5s/^# \{0,1\}//p' "$0"; exit 0 ;;
+    *) echo "setup: unknown option '$arg' (expected --test, --print)" >&2; exit 2 ;;
+  esac
+done
+
+PACKAGES=("${BUILD_PACKAGES[@]}" "${RUNTIME_PACKAGES[@]}")
+if [ "$with_tests" = 1 ]; then PACKAGES+=("${TEST_PACKAGES[@]}"); fi
+if [ "$print_only" = 1 ]; then printf '%s\n' "${PACKAGES[@]}"; exit 0; fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi

@@ -6,7 +6,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 
-scripts/setup.sh
+scripts/setup.sh --test  # build, runtime and the test-only tools (browser, VM)
 jobs="$(nproc)"
 
 echo "== release build and tests"

@@ -3,6 +3,7 @@
 
 #include <time.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -342,7 +343,13 @@ LcmSubscriber::LcmSubscriber(const std::string& url, const LcmChannels& known, c
 
 LcmSubscriber::~LcmSubscriber() = default;
 
-bool LcmSubscriber::handle(int timeout_ms) { return lcm_->handleTimeout(timeout_ms) >= 0; }
+bool LcmSubscriber::handle(int timeout_ms) {
+  // lcm_handle_timeout waits in select(), which a signal interrupts with EINTR whatever SA_RESTART says
+  // (signal(7)); that is the caller's cue to look at its stop flag, not an LCM failure.
+  errno = 0;
+  if (lcm_->handleTimeout(timeout_ms) >= 0) return true;
+  return errno == EINTR;
+}
 
 void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string& channel, Route* route) {
   LcmSubscriber& self = *route->self;

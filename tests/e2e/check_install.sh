@@ -1,15 +1,32 @@
 #!/bin/sh
-# `cmake --install` puts the service binary, the unit, the default config and the LCM definitions in place.
+# `cmake --install` puts the service binary, the unit, the default config and the LCM definitions in place,
+# at the FHS paths a package uses: with --prefix /usr the config is /etc/toposlam/toposlam.yaml (where
+# toposlamd and the unit's ConfigurationDirectory= look), never /usr/etc. Another prefix keeps it under
+# the prefix (P/etc/toposlam).
 set -eu
 build="$1"
 dest="$(mktemp -d)"
 trap 'rm -rf "$dest"' EXIT
-cmake --install "$build" --prefix "$dest/usr" >/dev/null
-for f in usr/sbin/toposlamd usr/bin/toposlam usr/lib/systemd/system/toposlamd.service usr/etc/toposlam/toposlam.yaml \
-         usr/share/toposlam/lcm/place_t.lcm usr/share/toposlam/lcm/motion_t.lcm usr/include/toposlam_lcm/place_t.hpp; do
-  [ -e "$dest/$f" ] || { echo "missing after install: $f"; exit 1; }
+fail() { echo "$*"; exit 1; }
+
+# 1. A package's install: DESTDIR staging, prefix /usr.
+DESTDIR="$dest/pkg" cmake --install "$build" --prefix /usr >/dev/null
+for f in usr/sbin/toposlamd usr/bin/toposlam usr/lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
+         usr/share/toposlam/lcm/place_t.lcm usr/share/toposlam/lcm/motion_t.lcm usr/include/toposlam_lcm/place_t.hpp \
+         usr/share/doc/toposlam/examples/50-toposlam-multicast.network etc/toposlam/toposlam-bridge.yaml; do
+  [ -e "$dest/pkg/$f" ] || fail "missing after install --prefix /usr: $f"
 done
-grep -q "^ExecStart=$dest/usr/sbin/toposlamd\$" "$dest/usr/lib/systemd/system/toposlamd.service" \
-  || { echo "the installed unit does not start the installed binary"; exit 1; }
-"$dest/usr/sbin/toposlamd" --check-config -c "$dest/usr/etc/toposlam/toposlam.yaml"
+[ ! -e "$dest/pkg/usr/etc" ] || fail "install --prefix /usr wrote usr/etc/ (toposlamd never reads it): $(find "$dest/pkg/usr/etc")"
+grep -q "^ExecStart=/usr/sbin/toposlamd\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
+  || fail "the unit installed with --prefix /usr does not start /usr/sbin/toposlamd"
+"$dest/pkg/usr/sbin/toposlamd" --check-config -c "$dest/pkg/etc/toposlam/toposlam.yaml"
+
+# 2. A private prefix: everything under it, the unit pointing at its binary.
+cmake --install "$build" --prefix "$dest/local" >/dev/null
+for f in sbin/toposlamd bin/toposlam lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml; do
+  [ -e "$dest/local/$f" ] || fail "missing after install --prefix P: P/$f"
+done
+grep -q "^ExecStart=$dest/local/sbin/toposlamd\$" "$dest/local/lib/systemd/system/toposlamd.service" \
+  || fail "the installed unit does not start the installed binary"
+"$dest/local/sbin/toposlamd" --check-config -c "$dest/local/etc/toposlam/toposlam.yaml"
 echo "install OK"

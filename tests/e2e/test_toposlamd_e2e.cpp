@@ -10,6 +10,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -224,6 +225,13 @@ SCENARIO("toposlamd maps the simulated two-traversal office and publishes it ove
       CHECK(contains(run.notifications, "READY=1"));
       CHECK(contains(run.notifications, "STATUS=running"));
       CHECK(contains(run.notifications, "WATCHDOG=1"));
+    }
+    THEN("the end of the route (no signal) was announced with STOPPING=1 after READY=1") {
+      const auto ready = std::find(run.notifications.begin(), run.notifications.end(), "READY=1");
+      const auto stopping = std::find(run.notifications.begin(), run.notifications.end(), "STOPPING=1");
+      CHECK(ready != run.notifications.end());
+      CHECK(stopping != run.notifications.end());
+      CHECK(ready < stopping);
     }
     THEN("a place message arrived for (nearly) every frame, in order") {
       // UDP may lose a datagram under load; the daemon itself drops nothing in block mode.

@@ -1,13 +1,26 @@
 // `toposlam listen`: prints toposlamd's LCM messages as they arrive (place estimates, place events,
 // topology, status), one line each, or one JSON object per line with --json. For people on the robot and
 // for scripts: `toposlam listen --count 10 --json | jq .node`.
+//
+// It reads the daemon's config (-c FILE, else the same look-up as toposlamd) for lcm.url and the channel
+// names, so a robot whose config renames the channels needs no extra options. Ctrl-C and SIGTERM end it
+// with exit status 0 (and, with --hz, the per-channel message rates).
+#include <pthread.h>
+#include <signal.h>
+
 #include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
 #include "commands.hpp"
+#include "toposlam/config/config_path.hpp"
+#include "toposlam/core/json_writer.hpp"
+#include "toposlam/config/daemon_config.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
 
 namespace toposlam::cli {
@@ -16,6 +29,34 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 void onInterrupt(int) { g_interrupted = 1; }
+
+sigset_t stopSignals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  return set;
+}
+
+// LCM's udpm provider receives on a thread of its own; blocked there, a stop signal always reaches this
+// (the calling) thread, whose select() then returns EINTR.
+void blockStopSignals() {
+  const sigset_t set = stopSignals();
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+}
+
+// sigaction without SA_RESTART: the handler only sets the flag, and the wait in select() returns EINTR
+// (which LcmSubscriber::handle treats as "look at the flag"), so the exit follows the signal at once.
+void catchStopSignals() {
+  struct sigaction action {};
+  action.sa_handler = onInterrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  const sigset_t set = stopSignals();
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+}
 
 std::vector<std::string> splitChannels(const std::string& text) {
   std::vector<std::string> out;
@@ -26,50 +67,113 @@ std::vector<std::string> splitChannels(const std::string& text) {
   return out;
 }
 
+LcmChannels channelsOf(const LcmSettings& lcm) {
+  LcmChannels c;
+  c.place = lcm.place_channel;
+  c.place_event = lcm.place_event_channel;
+  c.topology = lcm.topology_channel;
+  c.status = lcm.status_channel;
+  c.motion = lcm.motion_channel;
+  return c;
+}
+
+// A --channels item is a channel name of the config or one of its keys (place, place_event, topology,
+// status, motion), which stands for the name the config gives it.
+std::string resolveChannel(const std::string& item, const LcmChannels& known) {
+  if (item == "place") return known.place;
+  if (item == "place_event") return known.place_event;
+  if (item == "topology") return known.topology;
+  if (item == "status") return known.status;
+  if (item == "motion") return known.motion;
+  return item;
+}
+
+std::string formatRate(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", value);
+  return text;
+}
+
 }  // namespace
 
 void addListenCommand(CLI::App& app) {
   struct Options {
-    std::string url = "udpm://239.255.76.67:7667?ttl=0";
-    std::string channels = "TOPOSLAM_PLACE,TOPOSLAM_PLACE_EVENT";
+    std::string config;
+    std::string url;
+    std::string channels;
     long long count = 0;
     double timeout_s = 0.0;
     bool json = false;
+    bool hz = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("listen", "print toposlamd's place messages (LCM) as they arrive");
-  cmd->add_option("--url", options->url, "LCM URL (toposlam.yaml lcm.url)")->capture_default_str();
+  cmd->add_option("-c,--config", options->config,
+                  "toposlamd's config, for lcm.url and lcm.channels (default: " + defaultDaemonConfigPath() +
+                      " if it exists, else the built-in defaults)");
+  cmd->add_option("--url", options->url, "LCM URL (default: the config's lcm.url)");
   cmd->add_option("--channels", options->channels,
-                  "comma-separated channels: TOPOSLAM_PLACE, TOPOSLAM_PLACE_EVENT, TOPOSLAM_TOPOLOGY, TOPOSLAM_STATUS, "
-                  "TOPOSLAM_MOTION")
-      ->capture_default_str();
+                  "comma-separated channels, by name or by config key: place, place_event, topology, status, motion "
+                  "(default: place,place_event)");
   cmd->add_option("--count", options->count, "stop after N messages (0 = no limit)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--timeout", options->timeout_s, "stop after S seconds (0 = no limit); exit code 3 if nothing arrived")
+  cmd->add_option("--timeout", options->timeout_s, "stop after S seconds (0 = no limit); exit status 1 if nothing arrived")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", options->json, "one JSON object per line");
+  cmd->add_flag("--hz", options->hz, "at the end, print each channel's message count and rate (messages per second)");
   cmd->callback([options] {
-    const std::vector<std::string> channels = splitChannels(options->channels);
-    if (channels.empty()) throw std::invalid_argument("--channels: give at least one channel");
+    DaemonConfig config;
+    const std::string config_path = options->config.empty() ? defaultDaemonConfigPath() : options->config;
+    if (!options->config.empty() || std::filesystem::exists(config_path)) config = loadDaemonConfig(config_path);
+    const LcmChannels known = channelsOf(config.lcm);
+    const std::string url = options->url.empty() ? config.lcm.url : options->url;
+
+    std::vector<std::string> channels;
+    for (const std::string& item : splitChannels(options->channels.empty() ? "place,place_event" : options->channels))
+      channels.push_back(resolveChannel(item, known));
+    if (channels.empty()) throw CLI::ValidationError("--channels", "give at least one channel");
+    for (const std::string& c : channels)
+      if (c != known.place && c != known.place_event && c != known.topology && c != known.status && c != known.motion)
+        throw CLI::ValidationError("--channels", "unknown channel '" + c + "': the config (" + config_path +
+                                                     ") names " + known.place + ", " + known.place_event + ", " +
+                                                     known.topology + ", " + known.status + ", " + known.motion);
+
     long long printed = 0;
-    LcmSubscriber subscriber(options->url, LcmChannels{}, channels, [&](const ReceivedMessage& m) {
+    std::map<std::string, long long> per_channel;
+    for (const std::string& c : channels) per_channel[c] = 0;
+    blockStopSignals();  // until the handlers are in place: a signal now waits for them
+    LcmSubscriber subscriber(url, known, channels, [&](const ReceivedMessage& m) {
+      ++per_channel[m.channel];
       if (options->count > 0 && printed >= options->count) return;
       std::cout << (options->json ? m.json : m.summary) << "\n" << std::flush;
       ++printed;
     });
-    std::signal(SIGINT, onInterrupt);
-    std::signal(SIGTERM, onInterrupt);
+    catchStopSignals();
     const auto start = std::chrono::steady_clock::now();
     while (g_interrupted == 0 && (options->count == 0 || printed < options->count)) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (options->timeout_s > 0 && elapsed >= options->timeout_s) break;
-      if (!subscriber.handle(100)) throw std::runtime_error("LCM receive failed on " + options->url);
+      if (!subscriber.handle(100)) throw std::runtime_error("LCM receive failed on " + url);
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (options->hz) {
+      for (const auto& [channel, n] : per_channel) {
+        const std::string hz = formatRate(elapsed > 0 ? static_cast<double>(n) / elapsed : 0.0);
+        if (options->json)
+          std::cout << "{\"rate\":{\"channel\":\"" << JsonWriter::escape(channel) << "\",\"messages\":" << n
+                    << ",\"seconds\":" << formatRate(elapsed) << ",\"hz\":" << hz << "}}\n";
+        else
+          std::cout << "rate " << channel << ": " << n << " messages in " << formatRate(elapsed) << " s = " << hz
+                    << " Hz\n";
+      }
+      std::cout << std::flush;
     }
     if (subscriber.malformed() > 0)
       std::cerr << "toposlam listen: " << subscriber.malformed() << " messages could not be decoded\n";
-    if (printed == 0 && options->timeout_s > 0) {
-      std::cerr << "toposlam listen: no message within " << options->timeout_s << " s on " << options->url
-                << " (is toposlamd running? same lcm.url and multicast route?)\n";
-      throw CLI::RuntimeError(3);
+    if (printed == 0 && options->timeout_s > 0 && g_interrupted == 0) {
+      std::ostringstream message;
+      message << "listen: no message within " << options->timeout_s << " s on " << url
+              << " (is toposlamd running? same lcm.url and multicast route?)";
+      throw std::runtime_error(message.str());
     }
   });
 }

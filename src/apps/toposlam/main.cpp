@@ -1,9 +1,14 @@
 // toposlam: the offline command-line tool (fingerprint, similarity, localize, segment, map, sim, eval,
 // report, bench, listen). Thin: it parses arguments, builds the objects and runs them.
+//
+// Exit status, the same in every command and in toposlamd: 0 ok, 1 runtime error (a file, camera or the
+// network failed), 2 usage or config error (bad option, bad value, bad config file). CLI11's own codes
+// (105-109 and up) are folded into 2 here.
 #include <exception>
 #include <iostream>
 
 #include "commands.hpp"
+#include "toposlam/config/daemon_config.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"toposlam: visual topological SLAM for indoor robots with one forward-facing camera"};
@@ -23,8 +28,14 @@ int main(int argc, char** argv) {
   toposlam::cli::addRecognitionCommand(app);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own status, already explained on stderr
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int code = app.exit(e);  // prints the help, the version or the usage error
+    return code == 0 ? 0 : 2;
+  } catch (const toposlam::ConfigError& e) {
+    std::cerr << "toposlam: error: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "toposlam: error: " << e.what() << "\n";
     return 1;

@@ -205,6 +205,12 @@ int runDaemon(const DaemonConfig& config) {
                                             statusLine(pipeline.status()));
     }
   }
+  // The end of the stream (a file or simulator source ran out) is a stop too: systemd hears STOPPING=1
+  // before the final map save, as after a signal.
+  if (!stopping) {
+    notifier.stopping();
+    notifier.status("stopping: end of stream; saving the map");
+  }
   pipeline.wait();
   receiving.store(false);
   io_threads.joinAll();

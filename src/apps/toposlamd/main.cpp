@@ -2,44 +2,33 @@
 // $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
 // runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
 #include <csignal>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <iostream>
 #include <string>
-#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
 #include "sources.hpp"
+#include "toposlam/config/config_path.hpp"
 #include "toposlam/config/daemon_config.hpp"
+#include "toposlam/io/frame_source.hpp"
+#include "toposlam/topology/map_store.hpp"
 
 namespace {
 
-#ifndef TOPOSLAM_INSTALLED_CONFIG
-#define TOPOSLAM_INSTALLED_CONFIG "/etc/toposlam/toposlam.yaml"
-#endif
-
-// $CONFIGURATION_DIRECTORY/toposlam.yaml (systemd ConfigurationDirectory=), then /etc/toposlam/toposlam.yaml,
-// then the copy `cmake --install` put under the install prefix; the first that exists wins.
-std::string defaultConfigPath() {
-  std::vector<std::string> candidates;
-  if (const char* dir = std::getenv("CONFIGURATION_DIRECTORY"); dir != nullptr && dir[0] != '\0') {
-    std::string first(dir);
-    first = first.substr(0, first.find(':'));
-    candidates.push_back((std::filesystem::path(first) / "toposlam.yaml").string());
-  }
-  candidates.push_back("/etc/toposlam/toposlam.yaml");
-  candidates.push_back(TOPOSLAM_INSTALLED_CONFIG);
-  for (const std::string& c : candidates)
-    if (std::filesystem::exists(c)) return c;
-  return candidates.front();
+int startError(const std::exception& e, int code) {
+  std::cerr << "toposlamd: error: " << e.what() << "\n";
+  return code;
 }
 
 }  // namespace
 
+// Exit status: 0 ok (end of stream or a stop signal), 1 runtime error (LCM, the pipeline failed), 2 usage or
+// config error: a bad option, config, source or map that no restart fixes (the unit's
+// RestartPreventExitStatus=2).
 int main(int argc, char** argv) {
   // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
@@ -51,7 +40,7 @@ int main(int argc, char** argv) {
   double save_period = -1.0;
   toposlam::daemon::BenchOptions bench_options;
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
-                                                 defaultConfigPath() + " if it exists, else built-in defaults");
+                                                 toposlam::defaultDaemonConfigPath() + " if it exists, else built-in defaults");
   app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
   auto* map_option = app.add_option("--map", map_path,
                                     "override `map.path` (relative paths resolve against $STATE_DIRECTORY; \"\" = never saved)");
@@ -62,12 +51,17 @@ int main(int argc, char** argv) {
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
   app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
   app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints the help, the version or the usage error
+    return code == 0 ? 0 : 2;      // CLI11's own codes (105-109, ...) are usage errors: 2
+  }
 
   try {
     toposlam::DaemonConfig config;
     const bool explicit_config = !config_path.empty();
-    if (!explicit_config) config_path = defaultConfigPath();
+    if (!explicit_config) config_path = toposlam::defaultDaemonConfigPath();
     if (explicit_config || std::filesystem::exists(config_path)) {
       config = toposlam::loadDaemonConfig(config_path);
     } else {
@@ -94,8 +88,13 @@ int main(int argc, char** argv) {
       return toposlam::daemon::runBench(config, bench_options);
     }
     return toposlam::daemon::runDaemon(config);
+  } catch (const toposlam::ConfigError& e) {
+    return startError(e, 2);
+  } catch (const toposlam::FrameSourceError& e) {
+    return startError(e, 2);  // the configured source cannot be opened as given (URI, path, permissions)
+  } catch (const toposlam::MapStoreError& e) {
+    return startError(e, 2);  // the map is locked by another process, too large, or made with other settings
   } catch (const std::exception& e) {
-    std::cerr << "toposlamd: error: " << e.what() << "\n";
-    return 2;
+    return startError(e, 1);  // e.g. LCM cannot open yet (no network, no multicast route): a restart may help
   }
 }

@@ -98,7 +98,8 @@ class LcmSubscriber {
   ~LcmSubscriber();
   LcmSubscriber(const LcmSubscriber&) = delete;
   LcmSubscriber& operator=(const LcmSubscriber&) = delete;
-  /// Waits up to timeout_ms for messages and dispatches them; returns false on an LCM error.
+  /// Waits up to timeout_ms for messages and dispatches them; returns false on an LCM error. A signal that
+  /// interrupts the wait (EINTR) is not an error: it returns true early, so the caller can check its flags.
   bool handle(int timeout_ms);
   std::int64_t received() const { return received_.load(); }
   std::int64_t malformed() const { return malformed_.load(); }
