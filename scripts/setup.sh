@@ -7,7 +7,7 @@ set -euo pipefail
 
 # To build (scripts/build.sh builds the test suite too, so Catch2's headers are a build dependency).
 BUILD_PACKAGES=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config ccache
   libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
 )
