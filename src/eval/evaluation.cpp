@@ -343,6 +343,25 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
 
 // ---------------------------------------------------------------- output
 
+namespace {
+
+// "curve": the precision-recall points of a loop-closure measure (place pairs or frame detections).
+void writePrPoints(JsonWriter& json, const std::vector<PrPoint>& points) {
+  json.key("curve").beginArray();
+  for (const auto& p : points) {
+    json.beginObject()
+        .field("threshold", p.threshold)
+        .field("true_positives", p.true_positives)
+        .field("false_positives", p.false_positives)
+        .field("precision", p.precision)
+        .field("recall", p.recall)
+        .endObject();
+  }
+  json.endArray();
+}
+
+}  // namespace
+
 void writeEvalJson(std::ostream& out, const EvalResult& r) {
   JsonWriter json(out);
   json.beginObject();
@@ -368,17 +387,8 @@ void writeEvalJson(std::ostream& out, const EvalResult& r) {
     json.field("recall_at_100_precision", c.recall_at_full_precision);
     json.field("threshold_at_100_precision", c.threshold_at_full_precision);
     json.field("average_precision", c.average_precision);
-    json.key("curve").beginArray();
-    for (const auto& p : c.points) {
-      json.beginObject()
-          .field("threshold", p.threshold)
-          .field("true_positives", p.true_positives)
-          .field("false_positives", p.false_positives)
-          .field("precision", p.precision)
-          .field("recall", p.recall)
-          .endObject();
-    }
-    json.endArray().endObject();
+    writePrPoints(json, c.points);
+    json.endObject();
   }
   if (r.frame_loop_closure) {
     const RecognitionScore& c = *r.frame_loop_closure;
@@ -388,17 +398,8 @@ void writeEvalJson(std::ostream& out, const EvalResult& r) {
     json.field("recall_at_100_precision", c.recall_at_full_precision);
     json.field("threshold_at_100_precision", c.threshold_at_full_precision);
     json.field("average_precision", c.average_precision);
-    json.key("curve").beginArray();
-    for (const auto& p : c.curve) {
-      json.beginObject()
-          .field("threshold", p.threshold)
-          .field("true_positives", p.true_positives)
-          .field("false_positives", p.false_positives)
-          .field("precision", p.precision)
-          .field("recall", p.recall)
-          .endObject();
-    }
-    json.endArray().endObject();
+    writePrPoints(json, c.curve);
+    json.endObject();
   }
   if (r.boundaries) {
     const BoundaryScore& b = *r.boundaries;

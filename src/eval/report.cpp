@@ -144,9 +144,11 @@ SvgPlot timingPlot(const RunData& run) {
   return plot;
 }
 
-SvgPlot precisionRecallPlot(const PrCurve& curve) {
+}  // namespace
+
+SvgPlot precisionRecallPlot(const std::string& title, const std::vector<PrSeries>& curves) {
   SvgPlot plot;
-  plot.title = "loop closure: precision vs. recall (score: node probability)";
+  plot.title = title;
   plot.x_label = "recall";
   plot.y_label = "precision";
   plot.width = 600;
@@ -155,16 +157,16 @@ SvgPlot precisionRecallPlot(const PrCurve& curve) {
   plot.x_max = 1.0;
   plot.y_min = 0.0;
   plot.y_max = 1.05;
-  SvgSeries s{"", {}, {}, "#9467bd", 2.0};
-  for (const auto& p : curve.points) {
-    s.x.push_back(p.recall);
-    s.y.push_back(p.precision);
+  for (const PrSeries& c : curves) {
+    SvgSeries s{c.label, {}, {}, c.colour, 2.0};
+    for (const auto& p : c.points) {
+      s.x.push_back(p.recall);
+      s.y.push_back(p.precision);
+    }
+    plot.series.push_back(std::move(s));
   }
-  plot.series.push_back(s);
   return plot;
 }
-
-}  // namespace
 
 std::string base64Encode(const std::vector<std::uint8_t>& bytes) {
   static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -225,6 +227,14 @@ std::vector<std::int64_t> framesForThumbnails(const RunData& run, int strip_coun
 }
 
 namespace {
+
+// Place-pair loop closures and, when frames.csv has them, the frame-level detections.
+SvgPlot loopClosurePlot(const EvalResult& eval) {
+  std::vector<PrSeries> curves{{"frame pairs on one node (score: node probability)", eval.loop_closure->points, "#9467bd"}};
+  if (eval.frame_loop_closure)
+    curves.push_back({"frame level (score: similarity x node probability)", eval.frame_loop_closure->curve, "#2ca02c"});
+  return precisionRecallPlot("loop closure: precision vs. recall", curves);
+}
 /// The topology drawing: HTML (an SVG of the edges under absolutely positioned <div>s with <img>, so the
 /// browser check sees every thumbnail) or one standalone SVG document (<image> elements).
 std::string topologyMarkup(const RunData& run, const std::vector<std::string>& thumbnails, bool svg_only) {
@@ -361,7 +371,7 @@ std::map<std::string, std::string> renderReportFigures(const ReportInputs& in) {
   }
   if (!run.timing.empty()) figures["timing.svg"] = renderSvgLinePlot(timingPlot(run));
   if (in.eval && in.eval->loop_closure && !in.eval->loop_closure->points.empty()) {
-    figures["precision_recall.svg"] = renderSvgLinePlot(precisionRecallPlot(*in.eval->loop_closure));
+    figures["precision_recall.svg"] = renderSvgLinePlot(loopClosurePlot(*in.eval));
   }
   return figures;
 }
@@ -491,7 +501,7 @@ std::string renderReportHtml(const ReportInputs& in) {
          << ").</p>\n";
     html << formatEvalHtml(*in.eval);
     if (in.eval->loop_closure && !in.eval->loop_closure->points.empty()) {
-      html << "<div>" << inlineSvg(precisionRecallPlot(*in.eval->loop_closure)) << "</div>\n";
+      html << "<div>" << inlineSvg(loopClosurePlot(*in.eval)) << "</div>\n";
     }
   } else {
     html << "<p>No ground truth given (<code>--truth labels.csv | GT.bmp | pairs.csv</code>).</p>\n";

@@ -56,6 +56,16 @@ eval::RecognitionTruth samplesTruth(const Frames& frames) {
   return eval::sequenceTruthFromMatrix(m, 10);
 }
 
+// Fills every candidate cell with similarity(query i, reference j) and scores the matrix.
+template <typename Similarity>
+eval::RecognitionScore scoreMatrix(const eval::RecognitionTruth& truth, Similarity similarity) {
+  std::vector<float> s(truth.state.size(), 0.f);
+  for (int i = 0; i < truth.queries; ++i)
+    for (int j = 0; j < truth.references; ++j)
+      if (truth.at(i, j) >= 0) s[static_cast<std::size_t>(i * truth.references + j)] = static_cast<float>(similarity(i, j));
+  return eval::scoreRecognition(s, truth);
+}
+
 eval::RecognitionScore scoreOurs(const std::string& preset_name, const Frames& queries, const Frames& references,
                                  const eval::RecognitionTruth& truth) {
   const SimilarityPreset preset = similarityPreset(preset_name);
@@ -64,13 +74,9 @@ eval::RecognitionScore scoreOurs(const std::string& preset_name, const Frames& q
   std::vector<Fingerprint> q, r;
   for (const cv::Mat& image : queries.images) q.push_back(extractor.extract(image));
   for (const cv::Mat& image : references.images) r.push_back(extractor.extract(image));
-  std::vector<float> s(truth.state.size(), 0.f);
-  for (int i = 0; i < truth.queries; ++i)
-    for (int j = 0; j < truth.references; ++j)
-      if (truth.at(i, j) >= 0)
-        s[static_cast<std::size_t>(i * truth.references + j)] = static_cast<float>(
-            similarity.symmetricSimilarity(r[static_cast<std::size_t>(j)], q[static_cast<std::size_t>(i)]));
-  return eval::scoreRecognition(s, truth);
+  return scoreMatrix(truth, [&](int i, int j) {
+    return similarity.symmetricSimilarity(r[static_cast<std::size_t>(j)], q[static_cast<std::size_t>(i)]);
+  });
 }
 
 eval::RecognitionScore scoreBaseline(const Frames& queries, const Frames& references, const eval::RecognitionTruth& truth) {
@@ -78,13 +84,9 @@ eval::RecognitionScore scoreBaseline(const Frames& queries, const Frames& refere
   std::vector<cv::Mat> q, r;
   for (const cv::Mat& image : queries.images) q.push_back(baseline.extract(image));
   for (const cv::Mat& image : references.images) r.push_back(baseline.extract(image));
-  std::vector<float> s(truth.state.size(), 0.f);
-  for (int i = 0; i < truth.queries; ++i)
-    for (int j = 0; j < truth.references; ++j)
-      if (truth.at(i, j) >= 0)
-        s[static_cast<std::size_t>(i * truth.references + j)] =
-            static_cast<float>(baseline.similarity(r[static_cast<std::size_t>(j)], q[static_cast<std::size_t>(i)]));
-  return eval::scoreRecognition(s, truth);
+  return scoreMatrix(truth, [&](int i, int j) {
+    return baseline.similarity(r[static_cast<std::size_t>(j)], q[static_cast<std::size_t>(i)]);
+  });
 }
 
 std::string figures(const eval::RecognitionScore& s) {

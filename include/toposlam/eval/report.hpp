@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "toposlam/core/svg_plot.hpp"
 #include "toposlam/eval/evaluation.hpp"
 
 namespace toposlam::eval {
@@ -40,6 +41,15 @@ std::string renderReportHtml(const ReportInputs& inputs);
 
 /// Standard base64 (RFC 4648, with padding).
 std::string base64Encode(const std::vector<std::uint8_t>& bytes);
+
+/// One precision-recall curve of a plot.
+struct PrSeries {
+  std::string label;
+  std::vector<PrPoint> points;
+  std::string colour;
+};
+/// Precision (y) against recall (x), both in [0, 1], one line per curve (report, `toposlam recognition`).
+SvgPlot precisionRecallPlot(const std::string& title, const std::vector<PrSeries>& curves);
 /// A distinct, stable colour for index i (CSS "hsl(...)"); grey for i < 0.
 std::string indexColour(int i);
 /// The report's figures as standalone SVG documents by file name: strip.svg, rooms.svg (with labels),

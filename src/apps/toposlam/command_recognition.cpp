@@ -28,6 +28,7 @@
 #include "toposlam/eval/evaluation.hpp"
 #include "toposlam/eval/orb_baseline.hpp"
 #include "toposlam/eval/recognition.hpp"
+#include "toposlam/eval/report.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
@@ -211,26 +212,11 @@ void writeHeatMap(const std::string& path, const MethodResult& m, const eval::Re
 }
 
 void writePrSvg(const std::string& path, const std::vector<MethodResult>& methods) {
-  SvgPlot plot;
-  plot.title = "Place recognition: precision-recall of each query's best match";
-  plot.x_label = "recall";
-  plot.y_label = "precision";
-  plot.x_min = 0.0;
-  plot.x_max = 1.0;
-  plot.y_min = 0.0;
-  plot.y_max = 1.02;
   const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c"};
-  for (std::size_t k = 0; k < methods.size(); ++k) {
-    SvgSeries s;
-    s.label = methods[k].name;
-    s.colour = colours[k % 3];
-    for (const auto& p : methods[k].score.curve) {
-      s.x.push_back(p.recall);
-      s.y.push_back(p.precision);
-    }
-    plot.series.push_back(std::move(s));
-  }
-  writeFileAtomically(path, renderSvgLinePlot(plot));
+  std::vector<eval::PrSeries> curves;
+  for (std::size_t k = 0; k < methods.size(); ++k) curves.push_back({methods[k].name, methods[k].score.curve, colours[k % 3]});
+  writeFileAtomically(path, renderSvgLinePlot(eval::precisionRecallPlot(
+                                "Place recognition: precision-recall of each query's best match", curves)));
 }
 
 std::string fixed3(double v) {
