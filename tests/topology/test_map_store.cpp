@@ -372,7 +372,13 @@ TEST_CASE("GIVEN a damaged map and a damaged .prev WHEN recovered THEN nothing l
 TEST_CASE("GIVEN a damaged map in a read-only directory WHEN recovered THEN the log says it could not be moved",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("recover-readonly");
+  // Under the system temp folder, not the build tree: the child runs as nobody, who may not be able to
+  // reach a checkout inside a private folder (a mktemp -d clone, as CI's may be).
+  const fs::path dir = fs::temp_directory_path() / ("toposlam-recover-readonly-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::permissions(dir, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                           fs::perms::others_exec);
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 4);
   MapStore::save(path, *filter, "first");
@@ -397,6 +403,7 @@ TEST_CASE("GIVEN a damaged map in a read-only directory WHEN recovered THEN the 
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
   CHECK(countPrefix(dir, "map.tsm.damaged-") == 0);
+  fs::remove_all(dir);
 }
 
 TEST_CASE("GIVEN a map locked by one writer WHEN a second one locks it THEN it is refused naming the lock file",
