@@ -32,6 +32,7 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/matching/sequence_similarity.hpp"
 #include "toposlam/matching/similarity_preset.hpp"
 
 namespace toposlam::cli {
@@ -62,6 +63,7 @@ struct RecognitionOptions {
   bool quiet = false;
   double scale = 1.0;  ///< frames are resized by this factor before anything else
   int orb_levels = -1;  ///< -1: the preset's
+  int sequence_length = 1;  ///< > 1: each method is also scored as sequences of this many frames
 };
 
 /// Strips an optional "images:" scheme: the recognition command reads image files only.
@@ -212,9 +214,9 @@ void writeHeatMap(const std::string& path, const MethodResult& m, const eval::Re
 }
 
 void writePrSvg(const std::string& path, const std::vector<MethodResult>& methods) {
-  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c"};
+  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e"};
   std::vector<eval::PrSeries> curves;
-  for (std::size_t k = 0; k < methods.size(); ++k) curves.push_back({methods[k].name, methods[k].score.curve, colours[k % 3]});
+  for (std::size_t k = 0; k < methods.size(); ++k) curves.push_back({methods[k].name, methods[k].score.curve, colours[k % 4]});
   writeFileAtomically(path, renderSvgLinePlot(eval::precisionRecallPlot(
                                 "Place recognition: precision-recall of each query's best match", curves)));
 }
@@ -301,13 +303,28 @@ void runRecognition(const RecognitionOptions& o) {
     });
     methods.push_back(std::move(b));
   }
+  if (o.sequence_length > 1) {
+    // Every method once more, scored as sequences (sequence_similarity.hpp), in the same run.
+    std::vector<std::uint8_t> candidate(truth.state.size());
+    for (std::size_t k = 0; k < candidate.size(); ++k) candidate[k] = truth.state[k] >= 0 ? 1 : 0;
+    const std::size_t singles = methods.size();
+    for (std::size_t k = 0; k < singles; ++k) {
+      MethodResult m = methods[k];
+      m.name += ", seq " + std::to_string(o.sequence_length);
+      m.similarity = sequenceSimilarity(methods[k].similarity, candidate, truth.queries, truth.references,
+                                        o.sequence_length);
+      m.score = eval::scoreRecognition(m.similarity, truth);
+      methods.push_back(std::move(m));
+    }
+  }
 
   if (!o.out.empty()) {
     fs::create_directories(o.out);
+    const std::size_t singles = o.sequence_length > 1 ? methods.size() / 2 : methods.size();
     for (std::size_t k = 0; k < methods.size(); ++k) {
-      const std::string stem = k == 0 ? "similarity" : "similarity-baseline";
-      writeMatrixCsv(o.out + "/" + stem + ".csv", methods[k], truth);
-      writeHeatMap(o.out + "/" + (k == 0 ? "heatmap" : "heatmap-baseline") + ".png", methods[k], truth);
+      const std::string suffix = std::string(k % singles == 0 ? "" : "-baseline") + (k >= singles ? "-sequence" : "");
+      writeMatrixCsv(o.out + "/similarity" + suffix + ".csv", methods[k], truth);
+      writeHeatMap(o.out + "/heatmap" + suffix + ".png", methods[k], truth);
     }
     writePrSvg(o.out + "/precision-recall.svg", methods);
   }
@@ -317,6 +334,7 @@ void runRecognition(const RecognitionOptions& o) {
     json.beginObject().field("layout", sequence ? "sequence" : "query-reference").field("truth", o.truth);
     json.field("queries", truth.queries).field("references", truth.references);
     if (sequence) json.field("min_gap", o.min_gap);
+    json.field("sequence_length", o.sequence_length);
     json.key("methods").beginArray();
     for (const MethodResult& m : methods) {
       const auto& s = m.score;
@@ -348,6 +366,9 @@ void runRecognition(const RecognitionOptions& o) {
   std::cout << "  queries with a true match: " << methods[0].score.queries_with_match << " of "
             << methods[0].score.queries << "; pairs: " << methods[0].score.positive_pairs << " same place, "
             << methods[0].score.negative_pairs << " different\n\n";
+  if (o.sequence_length > 1)
+    std::cout << "  \", seq " << o.sequence_length << "\": scored as sequences of " << o.sequence_length
+              << " frames (the mean similarity along the diagonal ending at each pair)\n\n";
   std::cout << "  " << std::left << std::setw(48) << "method" << std::right << std::setw(7) << "AUC" << std::setw(8)
             << "top-1" << std::setw(14) << "recall@100%P" << std::setw(12) << "ms/frame" << std::setw(12)
             << "us/compare" << "\n";
@@ -358,8 +379,7 @@ void runRecognition(const RecognitionOptions& o) {
               << fixed3(1000.0 * m.ms_per_comparison) << "\n";
   }
   if (!o.out.empty())
-    std::cout << "\nwrote " << o.out << "/{similarity,similarity-baseline}.csv, heatmap*.png, precision-recall.svg, "
-              << "recognition.json\n";
+    std::cout << "\nwrote " << o.out << "/similarity*.csv, heatmap*.png, precision-recall.svg, recognition.json\n";
 }
 
 }  // namespace
@@ -395,6 +415,10 @@ void addRecognitionCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "Folder for matrices (CSV), heat maps (PNG), precision-recall (SVG), JSON");
   cmd->add_flag("--json", o->json, "Print JSON instead of the table");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
+  cmd->add_option("--sequence", o->sequence_length,
+                  "Also score every method as sequences of this many frames (SeqSLAM-style; 1: single frames only)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--scale", o->scale, "Resize every frame by this factor first (both methods)")
       ->check(CLI::Range(0.05, 8.0));
   cmd->callback([o] { runRecognition(*o); });
