@@ -479,6 +479,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       out.motion_time_s = static_cast<double>(m.utime) * 1e-6;
       out.motion_distance_m = std::hypot(m.forward_m, m.lateral_m);
       out.motion_speed_mps = std::abs(m.linear_velocity_mps);
+      out.motion_turn_rate_rps = std::abs(m.angular_velocity_rps);
     }
   }
   if (!ok) {

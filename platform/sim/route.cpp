@@ -80,7 +80,8 @@ int Trajectory::traversalAt(double time_s) const {
 
 std::vector<std::string> routeNames(const World& world) {
   std::vector<std::string> names;
-  if (world.loop.size() >= 2) names = {"loop", "loop2", "loop3", "loopN (N = 1..20)", "reverse", "both", "stopgo"};
+  if (world.loop.size() >= 2)
+    names = {"loop", "loop2", "loop3", "loopN (N = 1..20)", "reverse", "both", "stopgo", "stops"};
   for (const auto& [name, path] : world.named_routes) names.push_back(name);
   return names;
 }
@@ -109,6 +110,16 @@ Trajectory buildTrajectory(const World& world, const std::string& route, const R
       }
       traversals.push_back(leg);
     }
+  } else if (route == "stops" && has_loop) {
+    // Issue 17's route: two traversals, the first with three 10 s stops (at the waypoints a fifth, two
+    // fifths and three fifths along the loop) and the leg that ends four fifths along at a third of the
+    // speed; the second at constant speed.
+    Leg first{closedLoop(world, false), 0};
+    const std::size_t n = first.path.size() - 1;  // waypoints after the start
+    for (const std::size_t k : {1u, 2u, 3u}) first.path[std::max<std::size_t>(1, k * n / 5)].pause_s += 10.0;
+    first.path[std::max<std::size_t>(1, 4 * n / 5)].speed_factor /= 3.0;
+    traversals.push_back(first);
+    traversals.push_back({closedLoop(world, false), 1});
   } else {
     for (const auto& [name, path] : world.named_routes) {
       if (name == route) traversals.push_back({path, 0});

@@ -297,6 +297,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     s.real("window_m", c.segmentation.window_m, 0, 1000, " metres (0 = off: no window in distance)");
     Section mo = s.child("motion");
     mo.real("standing_speed_mps", c.segmentation_motion.standing_speed_mps, 0, 10, " m/s");
+    mo.real("standing_turn_rate_rps", c.segmentation_motion.standing_turn_rate_rps, 0, 100, " rad/s");
     mo.real("standing_after_s", c.segmentation_motion.standing_after_s, 0, 3600, " seconds");
     mo.real("timeout_s", c.segmentation_motion.timeout_s, 0, 3600, " seconds", true);
     mo.finish();

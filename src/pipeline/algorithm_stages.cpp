@@ -38,7 +38,7 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
     const std::lock_guard<std::mutex> lock(motion_mutex_);
     applying_.swap(pending_motion_);
   }
-  for (const MotionSample& m : applying_) gate_.addSample(m.time_s, m.distance_increment_m, m.speed_mps);
+  for (const MotionSample& m : applying_) gate_.addSample(m.time_s, m.distance_increment_m, m.speed_mps, m.turn_rate_rps);
   applying_.clear();
   const bool was_known = last_motion_.known;
   last_motion_ = gate_.at(captured_at_s);

@@ -11,6 +11,8 @@ std::string MotionGateConfig::validate() const {
   std::ostringstream message;
   if (!(standing_speed_mps >= 0.0 && standing_speed_mps <= 10.0)) {
     message << "standing_speed_mps: " << standing_speed_mps << " m/s is outside the allowed range [0, 10]";
+  } else if (!(standing_turn_rate_rps >= 0.0 && standing_turn_rate_rps <= 100.0)) {
+    message << "standing_turn_rate_rps: " << standing_turn_rate_rps << " rad/s is outside the allowed range [0, 100]";
   } else if (!(standing_after_s >= 0.0 && standing_after_s <= 3600.0)) {
     message << "standing_after_s: " << standing_after_s << " s is outside the allowed range [0, 3600]";
   } else if (!(timeout_s > 0.0 && timeout_s <= 3600.0)) {
@@ -25,14 +27,16 @@ MotionGate::MotionGate(const MotionGateConfig& config) : config_(config) {
   }
 }
 
-bool MotionGate::addSample(double time_s, double distance_increment_m, double speed_mps) {
+bool MotionGate::addSample(double time_s, double distance_increment_m, double speed_mps, double turn_rate_rps) {
   if (!std::isfinite(time_s) || !std::isfinite(distance_increment_m) || !std::isfinite(speed_mps) ||
+      !std::isfinite(turn_rate_rps) ||
       (samples_ > 0 && time_s < last_time_s_)) {
     ++rejected_;
     return false;
   }
   const bool gap = samples_ > 0 && time_s - last_time_s_ > config_.timeout_s;
-  const bool slow = std::abs(speed_mps) < config_.standing_speed_mps;
+  const bool slow =
+      std::abs(speed_mps) < config_.standing_speed_mps && std::abs(turn_rate_rps) < config_.standing_turn_rate_rps;
   if (slow && (!slow_ || gap || samples_ == 0)) slow_since_s_ = time_s;
   slow_ = slow;
   distance_m_ += std::abs(distance_increment_m);

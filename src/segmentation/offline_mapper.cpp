@@ -68,9 +68,9 @@ SegmentedPlace OfflineMapper::toRunNumbering(SegmentedPlace place) const {
 }
 
 SegmenterStep OfflineMapper::segment(double time_s, const std::string& name,
-                                     std::shared_ptr<const Fingerprint> fingerprint) {
+                                     std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
   if (!current_) beginTraversal();
-  SegmenterStep step = current_->segment(time_s, name, std::move(fingerprint));
+  SegmenterStep step = current_->segment(time_s, name, std::move(fingerprint), motion);
   step.frame += static_cast<std::int64_t>(finished_.frames.size());
   if (step.closed_place) step.closed_place = toRunNumbering(std::move(*step.closed_place));
   return step;

@@ -38,13 +38,13 @@ std::shared_ptr<const Fingerprint> OfflineSegmentation::fingerprint(const cv::Ma
 }
 
 SegmenterStep OfflineSegmentation::segment(double time_s, const std::string& name,
-                                           std::shared_ptr<const Fingerprint> fingerprint) {
+                                           std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
   SegmentationFrameRecord row;
   row.frame = static_cast<std::int64_t>(run_.frames.size());
   row.time_s = time_s;
   row.name = name;
   row.keypoints = fingerprint ? fingerprint->keypointCount() : 0;
-  SegmenterStep step = segmenter_.addFrame(row.frame, time_s, std::move(fingerprint));
+  SegmenterStep step = segmenter_.addFrame(row.frame, time_s, std::move(fingerprint), motion);
   row.lambda2 = step.lambda2;
   run_.frames.push_back(std::move(row));
   if (step.closed_place) record(*step.closed_place);

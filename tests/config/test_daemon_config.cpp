@@ -75,6 +75,7 @@ SCENARIO("The shipped config documents the defaults in code") {
       CHECK(shipped.segmentation.window_m == 0.0);
       CHECK(shipped.segmentation_motion.standing_speed_mps == defaults.segmentation_motion.standing_speed_mps);
       CHECK(shipped.segmentation_motion.standing_after_s == defaults.segmentation_motion.standing_after_s);
+      CHECK(shipped.segmentation_motion.standing_turn_rate_rps == defaults.segmentation_motion.standing_turn_rate_rps);
       CHECK(shipped.segmentation_motion.timeout_s == defaults.segmentation_motion.timeout_s);
       CHECK(shipped.preset == defaults.preset);
       CHECK(shipped.similarity.matcher.mutual_check == defaults.similarity.matcher.mutual_check);
@@ -183,6 +184,7 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"segmentation: {window_m: -1}", "segmentation.window_m: -1 is out of range, allowed [0, 1000] metres"},
       {"segmentation: {motion: {timeout_s: 0}}", "segmentation.motion.timeout_s: 0 is out of range, allowed (0, 3600] seconds"},
       {"segmentation: {motion: {standing_speed_mps: 11}}", "segmentation.motion.standing_speed_mps: 11 is out of range"},
+      {"segmentation: {motion: {standing_turn_rate_rps: -1}}", "segmentation.motion.standing_turn_rate_rps: -1 is out of range"},
       {"segmentation: {motion: {stand: 1}}", "unknown key 'segmentation.motion.stand'"},
       {"topology: {particles: 0}", "topology.particles: 0 is out of range, allowed 1 .. 1000000"},
       {"topology: {particles: lots}", "topology.particles: expected an integer in 1 .. 1000000, got 'lots'"},

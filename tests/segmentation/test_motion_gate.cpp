@@ -113,4 +113,23 @@ TEST_CASE("GIVEN an out-of-range gate config WHEN validated or used THEN the key
   c = gateConfig();
   c.standing_after_s = std::nan("");
   CHECK(c.validate().find("standing_after_s") == 0);
+  c = gateConfig();
+  c.standing_turn_rate_rps = 101.0;
+  CHECK(c.validate().find("standing_turn_rate_rps") == 0);
+}
+
+TEST_CASE("GIVEN a robot turning on the spot WHEN asked THEN it is moving, and it stands once the turn ends",
+          "[motion_gate]") {
+  MotionGate gate(gateConfig());  // standing_turn_rate_rps 0.1 rad/s by default
+  double t = 0.0;
+  for (int i = 0; i < 20; ++i) REQUIRE(gate.addSample(t += 0.1, 0.0, 0.0, 1.0));  // 2 s at 1 rad/s, no travel
+  CHECK(gate.at(t).known);
+  CHECK_FALSE(gate.at(t).standing);
+  CHECK(gate.at(t).distance_m == 0.0);
+  for (int i = 0; i < 5; ++i) gate.addSample(t += 0.1, 0.0, 0.0, 0.05);  // below the turn threshold
+  CHECK_FALSE(gate.at(t).standing);  // 0.5 s still
+  for (int i = 0; i < 6; ++i) gate.addSample(t += 0.1, 0.0, 0.0, -0.05);
+  CHECK(gate.at(t).standing);        // 1.1 s still
+  CHECK_FALSE(gate.addSample(t += 0.1, 0.0, 0.0, std::numeric_limits<double>::infinity()));
+  CHECK(gate.rejectedSamples() == 1);
 }

@@ -39,6 +39,7 @@ struct MotionSample {
   double time_s = 0.0;                ///< pipeline clock (CLOCK_MONOTONIC seconds: motion_t.utime / 1e6)
   double distance_increment_m = 0.0;  ///< travelled since the previous sample
   double speed_mps = 0.0;
+  double turn_rate_rps = 0.0;  ///< yaw rate, rad/s (0 when the source has none)
 };
 
 /// FiedlerSegmenter. Keeps the thumbnails of the open place's frames (at most `max_thumbnails`, oldest

@@ -1,9 +1,10 @@
 // The robot's own motion for segmentation (thesis sections 4.4 and 6.3; docs/segmentation.md,
 // "Motion-aware segmentation"). Fed with motion samples (time, distance travelled since the previous
-// sample, speed), e.g. decoded from TOPOSLAM_MOTION, it answers per frame time:
+// sample, speed, turn rate), e.g. decoded from TOPOSLAM_MOTION, it answers per frame time:
 //   known     a sample arrived within `timeout_s` of the frame (the link is alive);
 //   standing  known, and every sample for at least `standing_after_s` up to now had a speed below
-//             `standing_speed_mps` (a short halt, e.g. a turn on the spot's first moment, is not a stop);
+//             `standing_speed_mps` and a turn rate below `standing_turn_rate_rps` (a short halt is not a
+//             stop, and a robot turning on the spot is not standing: its view sweeps the room);
 //   distance  the distance travelled so far (sum of |increment|; reversing counts as travel).
 // The FiedlerSegmenter then leaves standing frames out of its window and, with segmentation.window_m > 0,
 // sizes the window in metres (FiedlerSegmenter::addFrame with a MotionState).
@@ -22,6 +23,9 @@ namespace toposlam {
 struct MotionGateConfig {
   /// Slower than this (absolute speed, m/s) counts as standing; allowed [0, 10].
   double standing_speed_mps = 0.05;
+  /// Turning faster than this (absolute yaw rate, rad/s) is moving, whatever the speed; allowed [0, 100].
+  /// (Measured on the simulated office: without it the turns on the spot at each corner count as stops.)
+  double standing_turn_rate_rps = 0.1;
   /// The robot stands once it has been slower than standing_speed_mps for this long, seconds; [0, 3600].
   double standing_after_s = 1.0;
   /// Motion is known while the newest sample is at most this old at the frame's time, seconds; (0, 3600].
@@ -33,7 +37,7 @@ struct MotionGateConfig {
 /// What the gate says about one frame time.
 struct MotionState {
   bool known = false;  ///< a sample within timeout_s (link alive); false: segment by time as without motion
-  bool standing = false;    ///< known and slower than standing_speed_mps for standing_after_s or more
+  bool standing = false;    ///< known, slower than standing_speed_mps and not turning, for standing_after_s or more
   double distance_m = 0.0;  ///< travelled since the first sample (meaningful only when known)
 };
 
@@ -42,9 +46,10 @@ class MotionGate {
   /// Throws std::invalid_argument on an invalid config.
   explicit MotionGate(const MotionGateConfig& config);
 
-  /// One motion sample: `distance_increment_m` travelled since the previous sample, current `speed_mps`.
-  /// Returns false (and counts it in rejectedSamples()) when time goes back or a value is not finite.
-  bool addSample(double time_s, double distance_increment_m, double speed_mps);
+  /// One motion sample: `distance_increment_m` travelled since the previous sample, current `speed_mps`
+  /// and yaw rate `turn_rate_rps` (0 when the source has none). Returns false (and counts it in
+  /// rejectedSamples()) when time goes back or a value is not finite.
+  bool addSample(double time_s, double distance_increment_m, double speed_mps, double turn_rate_rps = 0.0);
 
   /// The state at a frame taken at `time_s` (from the samples added so far).
   MotionState at(double time_s) const;
@@ -60,7 +65,7 @@ class MotionGate {
   std::int64_t rejected_ = 0;
   double last_time_s_ = 0.0;
   double distance_m_ = 0.0;
-  bool slow_ = false;          ///< the newest sample was below standing_speed_mps
+  bool slow_ = false;          ///< the newest sample was below standing_speed_mps and not turning
   double slow_since_s_ = 0.0;  ///< time of the first sample of the current slow run
 };
 

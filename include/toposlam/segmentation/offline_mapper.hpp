@@ -45,7 +45,9 @@ class OfflineMapper {
 
   /// Step 2: segments the next frame. A place closed by this frame is returned in the step, numbered in
   /// run order; a kept one must then be given to mapPlace().
-  SegmenterStep segment(double time_s, const std::string& name, std::shared_ptr<const Fingerprint> fingerprint);
+  /// `motion` as in OfflineSegmentation::segment.
+  SegmenterStep segment(double time_s, const std::string& name, std::shared_ptr<const Fingerprint> fingerprint,
+                        const MotionState& motion = {});
 
   /// Step 3: one filter step with a kept place's representative (run numbering, as returned by
   /// segment() or finishTraversal()). Dropped places are ignored (returns std::nullopt).

@@ -19,6 +19,7 @@
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/segmentation/motion_gate.hpp"
 
 namespace toposlam {
 
@@ -50,9 +51,10 @@ class OfflineSegmentation {
   std::shared_ptr<const Fingerprint> fingerprint(const cv::Mat& image) const;
 
   /// Step 2: segments the next frame (numbered in call order from 0) and records its row. Returns the
-  /// step (lambda2 and, when a valley closed one, the place).
+  /// step (lambda2 and, when a valley closed one, the place). `motion`: the robot's motion at the frame
+  /// (MotionGate::at); unknown (the default) segments by time exactly as without motion.
   SegmenterStep segment(double time_s, const std::string& name,
-                        std::shared_ptr<const Fingerprint> fingerprint);
+                        std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion = {});
 
   /// Both steps at once.
   SegmenterStep process(const cv::Mat& image, double time_s, const std::string& name = "");

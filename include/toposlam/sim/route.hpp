@@ -47,6 +47,7 @@ class Trajectory {
 ///   loop      one traversal of the world's loop;   loopN (N = 1..20) N traversals in the same direction
 ///   reverse   the loop in the opposite direction;  both   the loop forwards, then backwards
 ///   stopgo    two traversals with seeded pauses (1.5..4 s) and speed changes (x0.4..x1.6)
+///   stops     two traversals, the first with three 10 s stops and one leg at a third of the speed
 ///   plus the world's own named routes.
 std::vector<std::string> routeNames(const World& world);
 /// Throws std::invalid_argument naming the route and listing the allowed ones if unknown.

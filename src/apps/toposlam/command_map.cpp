@@ -39,6 +39,7 @@
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/topology/map_store.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
+#include "motion_input.hpp"
 
 namespace toposlam::cli {
 
@@ -56,6 +57,8 @@ struct MapOptions {
   std::string resume;
   std::string keypoints = "orb";
   SegmentationOptions segmentation;
+  std::string motion;   ///< motion CSV (motion_input.hpp); empty: segment by time
+  double window_m = 0;  ///< with --motion: window in metres of travel (0: by time)
   int loop_min_gap = 10;  ///< frame-level loop closures: detections at least this many frames back
   std::string likelihood = toString(methodPreset("default").topology.likelihood);
   double relative_slope = methodPreset("default").topology.relative_slope;
@@ -117,7 +120,17 @@ std::string shellQuote(const std::string& text) {
 
 void runMap(const MapOptions& o, bool filter_options_given) {
   if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
-  const FiedlerSegmenterConfig segmenter_config = segmenterConfig(o.segmentation, "map");
+  const FiedlerSegmenterConfig segmenter_config = [&] {
+    FiedlerSegmenterConfig c = segmenterConfig(o.segmentation, "map");
+    c.window_m = o.window_m;
+    if (const std::string problem = c.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
+    return c;
+  }();
+  if (o.window_m > 0 && o.motion.empty()) throw std::invalid_argument("map: --window-m needs --motion");
+  if (!o.motion.empty() && o.sources.size() > 1)
+    throw std::invalid_argument("map: --motion takes one SOURCE (the motion file has one time base)");
+  std::optional<MotionReplay> motion;
+  if (!o.motion.empty()) motion.emplace(readMotionCsv(o.motion), MotionGateConfig{});
   const fs::path out_dir(o.out);
   createRunFolder(o.out);
 
@@ -205,7 +218,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       // With several sources, names carry their source's folder ("ref/0001.jpg", "query/0001.jpg") so
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
-      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint));
+      const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
+      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint), moving);
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
@@ -215,6 +229,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
   }
+  if (motion)
+    std::cerr << "map: motion from " << o.motion << ": " << motion->gate().samples() << " samples, "
+              << motion->standingFrames() << " frames taken standing (not segmented)"
+              << (motion->gate().rejectedSamples() > 0 ? ", " + std::to_string(motion->gate().rejectedSamples()) + " samples refused" : "")
+              << "\n";
   const SegmentationRun all = mapper.run();
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
@@ -430,6 +449,13 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
       ->capture_default_str();
   addSegmentationOptions(*cmd, options->segmentation);
+  cmd->add_option("--motion", options->motion,
+                  "Robot motion CSV (time_s,distance_m,speed_mps[,turn_rate_rps] in the frames' time base, e.g. sim's "
+                  "motion.csv): "
+                  "frames taken standing are not segmented");
+  cmd->add_option("--window-m", options->window_m, "With --motion: segmentation window in metres of travel (0: by time)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->callback([options, particles, alpha, seed, reps] {
     const bool filter_options_given = particles->count() + alpha->count() + seed->count() + reps->count() > 0;
     runMap(*options, filter_options_given);

@@ -1,12 +1,15 @@
 // `toposlam sim WORLD --route R --out DIR`: renders a route through a simulated world and writes the
 // frames (frames/000000.png ...), the ground truth (labels.csv: frame,time,room,x,y,heading,traversal), the
 // loop-closure matrix of the labels (loop_closure.png, laid out like samples_GT.bmp) and a top-down map
-// of the world with the route (map.png). Rendering speed is measured by `toposlam bench sim`.
+// of the world with the route (map.png), and the robot's own motion as wheel odometry would give it
+// (motion.csv: time_s,distance_m,speed_mps,turn_rate_rps per frame; `map --motion`). Rendering speed: `toposlam bench sim`.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <numbers>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
@@ -76,6 +79,12 @@ void runSim(const SimOptions& options) {
   std::ofstream timestamps(out / "frames" / "timestamps.csv");
   if (!timestamps) throw std::runtime_error("--out: cannot write '" + (out / "frames" / "timestamps.csv").string() + "'");
   timestamps << "name,time_s\n";
+  // The robot's own motion as its wheel odometry would report it, one sample per frame: distance driven
+  // since the previous frame and the mean speed over it (read by `map --motion`; docs/segmentation.md).
+  std::ofstream motion(out / "motion.csv");
+  if (!motion) throw std::runtime_error("--out: cannot write '" + (out / "motion.csv").string() + "'");
+  motion << "time_s,distance_m,speed_mps,turn_rate_rps\n";
+  double previous_time_s = 0.0;
   std::vector<sim::Pose> poses;
   std::vector<int> traversals, rooms;
   const std::int64_t frames = simulator.frameCount();
@@ -96,6 +105,19 @@ void runSim(const SimOptions& options) {
     char stamp[64];
     std::snprintf(stamp, sizeof stamp, "%s,%.6f\n", name, frame.truth.time_s);
     timestamps << stamp;
+    {
+      const double step_m =
+          poses.empty() ? 0.0 : std::hypot(frame.truth.pose.x - poses.back().x, frame.truth.pose.y - poses.back().y);
+      const double dt = frame.truth.time_s - previous_time_s;
+      const double turn_rad =
+          poses.empty() ? 0.0 : std::remainder(frame.truth.pose.heading - poses.back().heading, 2.0 * std::numbers::pi);
+      const bool rate = !poses.empty() && dt > 0.0;
+      char sample[128];
+      std::snprintf(sample, sizeof sample, "%.6f,%.6f,%.6f,%.6f\n", frame.truth.time_s, step_m, rate ? step_m / dt : 0.0,
+                    rate ? std::abs(turn_rad) / dt : 0.0);
+      motion << sample;
+      previous_time_s = frame.truth.time_s;
+    }
     poses.push_back(frame.truth.pose);
     traversals.push_back(frame.truth.traversal);
     rooms.push_back(frame.truth.room);
@@ -106,10 +128,12 @@ void runSim(const SimOptions& options) {
   if (!labels) throw std::runtime_error("--out: error while writing labels.csv");
   timestamps.flush();
   if (!timestamps) throw std::runtime_error("--out: error while writing frames/timestamps.csv");
+  motion.flush();
+  if (!motion) throw std::runtime_error("--out: error while writing motion.csv");
   cv::imwrite((out / "loop_closure.png").string(), sim::loopClosureMatrix(rooms));
   cv::imwrite((out / "map.png").string(),
               sim::drawWorldMap(simulator.world(), poses, traversals, 40.0, static_cast<int>(config.fps * 5)));
-  std::cerr << "sim: wrote " << frames << " frames, labels.csv, loop_closure.png and map.png to " << out.string()
+  std::cerr << "sim: wrote " << frames << " frames, labels.csv, motion.csv, loop_closure.png and map.png to " << out.string()
             << "\n";
 }
 
@@ -119,7 +143,7 @@ void addSimCommand(CLI::App& app) {
   auto options = std::make_shared<SimOptions>();
   auto* cmd = app.add_subcommand("sim", "Render a route through a simulated indoor world, with ground truth");
   cmd->add_option("world", options->world, "office | home | path to a YAML floor plan")->capture_default_str();
-  cmd->add_option("--route", options->route, "loop, loopN (N traversals), reverse, both, stopgo, or the world's own")
+  cmd->add_option("--route", options->route, "loop, loopN (N traversals), reverse, both, stopgo, stops, or the world's own")
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Output folder (frames/, labels.csv, loop_closure.png, map.png)");
   cmd->add_option("--fps", options->fps, "Frames per simulated second")->capture_default_str()->check(CLI::Range(0.1, 1000.0));

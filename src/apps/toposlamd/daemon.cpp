@@ -162,7 +162,7 @@ int runDaemon(const DaemonConfig& config) {
   FiedlerSegmentationStage& segmentation_stage = *parts.segmentation;
   LcmSubscriber motion(config.lcm.url, channels, {channels.motion}, [&](const ReceivedMessage& m) {
     motion_messages.fetch_add(1);
-    segmentation_stage.addMotion(MotionSample{m.motion_time_s, m.motion_distance_m, m.motion_speed_mps});
+    segmentation_stage.addMotion(MotionSample{m.motion_time_s, m.motion_distance_m, m.motion_speed_mps, m.motion_turn_rate_rps});
   });
   LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_messages);
 

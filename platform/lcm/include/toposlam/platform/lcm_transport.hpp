@@ -77,11 +77,12 @@ struct ReceivedMessage {
   int node = -1;            ///< place and place_event: the node
   int place = -1;
   bool is_new = false;
-  // motion messages: motion_t.utime in seconds (host CLOCK_MONOTONIC), hypot(forward_m, lateral_m) and
-  // |linear_velocity_mps|; time NaN for other kinds.
+  // motion messages: motion_t.utime in seconds (host CLOCK_MONOTONIC), hypot(forward_m, lateral_m),
+  // |linear_velocity_mps| and |angular_velocity_rps|; time NaN for other kinds.
   double motion_time_s = std::numeric_limits<double>::quiet_NaN();
   double motion_distance_m = 0.0;
   double motion_speed_mps = 0.0;
+  double motion_turn_rate_rps = 0.0;
 };
 
 /// True when every array length field of an encoded message of `kind` (place, place_event, status,

@@ -1,0 +1,67 @@
+// Motion CSV for the offline commands: see motion_input.hpp.
+#include "motion_input.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace toposlam::cli {
+namespace {
+
+double number(const std::string& field, const std::string& where, const char* what) {
+  char* end = nullptr;
+  const double v = std::strtod(field.c_str(), &end);
+  if (field.empty() || end == field.c_str() || *end != '\0' || !std::isfinite(v))
+    throw std::runtime_error(where + ": " + what + " '" + field + "' is not a finite number");
+  return v;
+}
+
+}  // namespace
+
+std::vector<MotionCsvSample> readMotionCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("--motion: cannot read '" + path + "'");
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error("--motion: '" + path + "' is empty");
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const bool with_turn = line == "time_s,distance_m,speed_mps,turn_rate_rps";
+  if (line != "time_s,distance_m,speed_mps" && !with_turn)
+    throw std::runtime_error("--motion: " + path + ":1: header must be 'time_s,distance_m,speed_mps' (and optionally "
+                             "',turn_rate_rps'), got '" + line + "'");
+  const std::string fields = with_turn ? "4 fields (time_s,distance_m,speed_mps,turn_rate_rps)" : "3 fields (time_s,distance_m,speed_mps)";
+  std::vector<MotionCsvSample> samples;
+  for (int number_of_line = 2; std::getline(in, line); ++number_of_line) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::string where = "--motion: " + path + ":" + std::to_string(number_of_line);
+    std::istringstream row(line);
+    std::string t, d, v, w, extra;
+    if (!std::getline(row, t, ',') || !std::getline(row, d, ',') || !std::getline(row, v, ',') ||
+        (with_turn && !std::getline(row, w, ',')) || std::getline(row, extra, ','))
+      throw std::runtime_error(where + ": expected " + fields + ", got '" + line + "'");
+    MotionCsvSample s{number(t, where, "time_s"), number(d, where, "distance_m"), number(v, where, "speed_mps"),
+                      with_turn ? number(w, where, "turn_rate_rps") : 0.0};
+    if (!samples.empty() && s.time_s < samples.back().time_s)
+      throw std::runtime_error(where + ": time_s " + t + " goes back in time");
+    samples.push_back(s);
+  }
+  if (samples.empty()) throw std::runtime_error("--motion: '" + path + "' has no samples");
+  return samples;
+}
+
+MotionReplay::MotionReplay(std::vector<MotionCsvSample> samples, const MotionGateConfig& config)
+    : samples_(std::move(samples)), gate_(config) {}
+
+MotionState MotionReplay::at(double frame_time_s) {
+  while (next_ < samples_.size() && samples_[next_].time_s <= frame_time_s) {
+    const MotionCsvSample& s = samples_[next_++];
+    gate_.addSample(s.time_s, s.distance_m, s.speed_mps, s.turn_rate_rps);
+  }
+  const MotionState state = gate_.at(frame_time_s);
+  if (state.known && state.standing) ++standing_frames_;
+  return state;
+}
+
+}  // namespace toposlam::cli

@@ -1,0 +1,42 @@
+// The robot's motion for the offline commands: a CSV of wheel-odometry samples in the frames' time base
+// (`time_s,distance_m,speed_mps[,turn_rate_rps]`: time of the sample, distance driven since the previous
+// one, speed, and optionally the yaw rate), as
+// `toposlam sim` writes it (motion.csv) or a robot's log gives it. `map --motion FILE` feeds it to the
+// segmenter's MotionGate, the same gate toposlamd feeds from TOPOSLAM_MOTION (docs/segmentation.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "toposlam/segmentation/motion_gate.hpp"
+
+namespace toposlam::cli {
+
+struct MotionCsvSample {
+  double time_s = 0.0;
+  double distance_m = 0.0;
+  double speed_mps = 0.0;
+  double turn_rate_rps = 0.0;
+};
+
+/// Reads a motion CSV (header `time_s,distance_m,speed_mps` or `time_s,distance_m,speed_mps,turn_rate_rps`). Throws std::runtime_error naming the file
+/// and line for a missing file, a wrong header, a short or non-numeric row, or a time that goes back.
+std::vector<MotionCsvSample> readMotionCsv(const std::string& path);
+
+/// Feeds a MotionGate the samples in time order up to each frame's time: at(t) adds every sample at or
+/// before t and returns the gate's state at t.
+class MotionReplay {
+ public:
+  MotionReplay(std::vector<MotionCsvSample> samples, const MotionGateConfig& config);
+  MotionState at(double frame_time_s);
+  const MotionGate& gate() const { return gate_; }
+  std::int64_t standingFrames() const { return standing_frames_; }
+
+ private:
+  std::vector<MotionCsvSample> samples_;
+  std::size_t next_ = 0;
+  MotionGate gate_;
+  std::int64_t standing_frames_ = 0;
+};
+
+}  // namespace toposlam::cli
