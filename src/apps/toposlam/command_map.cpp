@@ -57,8 +57,7 @@ struct MapOptions {
   std::string resume;
   std::string keypoints = "orb";
   SegmentationOptions segmentation;
-  std::string motion;   ///< motion CSV (motion_input.hpp); empty: segment by time
-  double window_m = 0;  ///< with --motion: window in metres of travel (0: by time)
+  MotionOptions motion;
   int loop_min_gap = 10;  ///< frame-level loop closures: detections at least this many frames back
   std::string likelihood = toString(methodPreset("default").topology.likelihood);
   double relative_slope = methodPreset("default").topology.relative_slope;
@@ -120,17 +119,8 @@ std::string shellQuote(const std::string& text) {
 
 void runMap(const MapOptions& o, bool filter_options_given) {
   if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
-  const FiedlerSegmenterConfig segmenter_config = [&] {
-    FiedlerSegmenterConfig c = segmenterConfig(o.segmentation, "map");
-    c.window_m = o.window_m;
-    if (const std::string problem = c.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
-    return c;
-  }();
-  if (o.window_m > 0 && o.motion.empty()) throw std::invalid_argument("map: --window-m needs --motion");
-  if (!o.motion.empty() && o.sources.size() > 1)
-    throw std::invalid_argument("map: --motion takes one SOURCE (the motion file has one time base)");
-  std::optional<MotionReplay> motion;
-  if (!o.motion.empty()) motion.emplace(readMotionCsv(o.motion), MotionGateConfig{});
+  FiedlerSegmenterConfig segmenter_config = segmenterConfig(o.segmentation, "map");
+  std::optional<MotionReplay> motion = openMotion(o.motion, o.sources.size(), "map", segmenter_config);
   const fs::path out_dir(o.out);
   createRunFolder(o.out);
 
@@ -229,11 +219,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
   }
-  if (motion)
-    std::cerr << "map: motion from " << o.motion << ": " << motion->gate().samples() << " samples, "
-              << motion->standingFrames() << " frames taken standing (not segmented)"
-              << (motion->gate().rejectedSamples() > 0 ? ", " + std::to_string(motion->gate().rejectedSamples()) + " samples refused" : "")
-              << "\n";
+  if (motion) std::cerr << motionSummary(*motion, o.motion, "map") << "\n";
   const SegmentationRun all = mapper.run();
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
@@ -449,13 +435,7 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
       ->capture_default_str();
   addSegmentationOptions(*cmd, options->segmentation);
-  cmd->add_option("--motion", options->motion,
-                  "Robot motion CSV (time_s,distance_m,speed_mps[,turn_rate_rps] in the frames' time base, e.g. sim's "
-                  "motion.csv): "
-                  "frames taken standing are not segmented");
-  cmd->add_option("--window-m", options->window_m, "With --motion: segmentation window in metres of travel (0: by time)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1000.0));
+  addMotionOptions(*cmd, options->motion);
   cmd->callback([options, particles, alpha, seed, reps] {
     const bool filter_options_given = particles->count() + alpha->count() + seed->count() + reps->count() > 0;
     runMap(*options, filter_options_given);

@@ -14,6 +14,7 @@
 
 #include "bench_stats.hpp"
 #include "commands.hpp"
+#include "motion_input.hpp"
 #include "offline_run_io.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/core/worker_pool.hpp"
@@ -31,6 +32,7 @@ struct SegmentOptions {
   std::string source;
   std::string out;
   SegmentationOptions segmentation;
+  MotionOptions motion;
   std::string keypoints = "orb";
   std::int64_t max_frames = 0;
   int workers = 1;
@@ -38,7 +40,8 @@ struct SegmentOptions {
 };
 
 void runSegment(const SegmentOptions& o) {
-  const FiedlerSegmenterConfig config = segmenterConfig(o.segmentation, "segment");
+  FiedlerSegmenterConfig config = segmenterConfig(o.segmentation, "segment");
+  std::optional<MotionReplay> motion = openMotion(o.motion, 1, "segment", config);
   const MethodPreset preset = presetOf(o.segmentation, "segment");
   VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
@@ -73,7 +76,8 @@ void runSegment(const SegmentOptions& o) {
     }
     fingerprint_ms.push_back(fingerprint_watch.elapsedMs());
     Stopwatch segment_watch;
-    const SegmenterStep step = pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
+    const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
+    const SegmenterStep step = pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint), moving);
     segment_ms.push_back(segment_watch.elapsedMs());
     timing.push_back(FrameTiming{fingerprint_ms.back(), segment_ms.back(), std::nullopt});
     const auto now = std::chrono::steady_clock::now();
@@ -89,6 +93,7 @@ void runSegment(const SegmentOptions& o) {
   }
   pipeline.finish();
   if (!o.quiet) std::cerr << "\n";
+  if (motion) std::cerr << motionSummary(*motion, o.motion, "segment") << "\n";
 
   const SegmentationRun& run = pipeline.run();
   if (run.frames.empty()) {
@@ -150,6 +155,7 @@ void addSegmentCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--out", options->out, "Output run folder (created if missing)")->required();
   addSegmentationOptions(*cmd, options->segmentation);
+  addMotionOptions(*cmd, options->motion);
   cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
       ->capture_default_str();
   cmd->add_option("--max-frames", options->max_frames, "Stop after this many frames (0: whole stream)");

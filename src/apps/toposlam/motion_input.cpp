@@ -51,6 +51,33 @@ std::vector<MotionCsvSample> readMotionCsv(const std::string& path) {
   return samples;
 }
 
+void addMotionOptions(CLI::App& command, MotionOptions& options) {
+  command.add_option("--motion", options.file,
+                     "Robot motion CSV (time_s,distance_m,speed_mps[,turn_rate_rps] in the frames' time base, e.g. "
+                     "sim's motion.csv): frames taken standing are not segmented");
+  command.add_option("--window-m", options.window_m, "With --motion: segmentation window in metres of travel (0: by time)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
+}
+
+std::optional<MotionReplay> openMotion(const MotionOptions& options, std::size_t sources, const std::string& command,
+                                       FiedlerSegmenterConfig& config) {
+  if (options.window_m > 0 && options.file.empty()) throw std::invalid_argument(command + ": --window-m needs --motion");
+  if (!options.file.empty() && sources > 1)
+    throw std::invalid_argument(command + ": --motion takes one SOURCE (the motion file has one time base)");
+  config.window_m = options.window_m;
+  if (const std::string problem = config.validate(); !problem.empty()) throw std::invalid_argument(command + ": " + problem);
+  if (options.file.empty()) return std::nullopt;
+  return MotionReplay(readMotionCsv(options.file), MotionGateConfig{});
+}
+
+std::string motionSummary(const MotionReplay& replay, const MotionOptions& options, const std::string& command) {
+  std::string text = command + ": motion from " + options.file + ": " + std::to_string(replay.gate().samples()) +
+                     " samples, " + std::to_string(replay.standingFrames()) + " frames taken standing (not segmented)";
+  if (replay.gate().rejectedSamples() > 0) text += ", " + std::to_string(replay.gate().rejectedSamples()) + " samples refused";
+  return text;
+}
+
 MotionReplay::MotionReplay(std::vector<MotionCsvSample> samples, const MotionGateConfig& config)
     : samples_(std::move(samples)), gate_(config) {}
 

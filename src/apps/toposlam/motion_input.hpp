@@ -5,9 +5,13 @@
 // segmenter's MotionGate, the same gate toposlamd feeds from TOPOSLAM_MOTION (docs/segmentation.md).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/segmentation/motion_gate.hpp"
 
 namespace toposlam::cli {
@@ -38,5 +42,18 @@ class MotionReplay {
   MotionGate gate_;
   std::int64_t standing_frames_ = 0;
 };
+
+/// `--motion FILE` and `--window-m M`, shared by `map` and `segment`.
+struct MotionOptions {
+  std::string file;     ///< motion CSV; empty: segment by time
+  double window_m = 0;  ///< with a file: window in metres of travel (0: by time)
+};
+void addMotionOptions(CLI::App& command, MotionOptions& options);
+/// Applies window_m to `config` (validated) and reads the file; std::nullopt without --motion. Throws
+/// std::invalid_argument "<command>: ..." for --window-m without --motion or with several sources.
+std::optional<MotionReplay> openMotion(const MotionOptions& options, std::size_t sources, const std::string& command,
+                                       FiedlerSegmenterConfig& config);
+/// "<command>: motion from FILE: N samples, M frames taken standing (not segmented)[, K samples refused]".
+std::string motionSummary(const MotionReplay& replay, const MotionOptions& options, const std::string& command);
 
 }  // namespace toposlam::cli
