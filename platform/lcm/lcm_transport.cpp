@@ -57,11 +57,11 @@ std::unique_ptr<lcm::LCM> openLcm(const std::string& url) {
 // --------------------------------------------------------------------------------------------------------
 
 LcmPipelineSink::LcmPipelineSink(const std::string& url, LcmChannels channels, int jpeg_quality,
-                                 const std::atomic<std::int64_t>* motion_messages)
+                                 const MotionStatusCounters* motion)
     : lcm_(openLcm(url)),
       channels_(std::move(channels)),
       jpeg_params_{cv::IMWRITE_JPEG_QUALITY, jpeg_quality},
-      motion_messages_(motion_messages) {
+      motion_(motion) {
   buffer_.reserve(64 * 1024);
   jpeg_.reserve(32 * 1024);
 }
@@ -181,7 +181,9 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.places = s.places;
   msg.map_revision = s.map_revision;
   msg.maps_saved = s.maps_saved;
-  msg.motion_messages = motion_messages_ ? motion_messages_->load() : 0;
+  msg.motion_messages = motion_ ? motion_->messages.load() : 0;
+  msg.motion_state = toString(motion_ ? static_cast<MotionUse>(motion_->use.load()) : MotionUse::None);
+  msg.motion_standing_frames = motion_ ? motion_->standing_frames.load() : 0;
   msg.num_stages = static_cast<std::int32_t>(s.stages.size());
   msg.stages.reserve(s.stages.size());
   for (const StageStatus& st : s.stages) {
@@ -289,7 +291,7 @@ const WireSchema kPlace = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fix
 const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length(), array(1), fixed(8)};
 const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
 const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
-                            length(), array(kStageStatus)};
+                            text(), fixed(8), length(), array(kStageStatus)};
 const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
 const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopologyNode), length(), array(12)};
 const WireSchema kMotion = {fixed(8 * 7 + 1)};
@@ -443,7 +445,8 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       jsonNumber(w, "latency_max_ms", m.latency_max_ms);
       jsonNumber(w, "cpu_percent", m.cpu_percent);
       w.field("places", m.places).field("map_revision", m.map_revision).field("maps_saved", m.maps_saved)
-          .field("motion_messages", m.motion_messages);
+          .field("motion_messages", m.motion_messages).field("motion_state", m.motion_state)
+          .field("motion_standing_frames", m.motion_standing_frames);
       w.key("stages").beginArray();
       for (const auto& st : m.stages) {
         w.beginObject().field("name", st.name);

@@ -62,6 +62,11 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
     time_s = std::isfinite(last_source_time_s_) ? last_source_time_s_ + 1.0 : 0.0;
   last_source_time_s_ = time_s;
   SegmenterStep step = segmenter_.addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
+  if (motion_counters_ != nullptr) {
+    const MotionUse use = last_motion_.known ? MotionUse::Used : gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
+    motion_counters_->use.store(static_cast<int>(use));
+    motion_counters_->standing_frames.store(segmenter_.skippedFrames());
+  }
   SegmentationStep out;
   if (step.lambda2) out.lambda2 = *step.lambda2;
   if (step.closed_place) out.closed = toClosedPlace(*step.closed_place);

@@ -106,7 +106,7 @@ TEST_CASE("GIVEN a small JPEG claiming 65500x65500 pixels WHEN read THEN it is r
                         Catch::Contains("over the cap"));
 }
 
-TEST_CASE("GIVEN an 8000x8000 PNG WHEN read with the default cap THEN refused; with a higher cap the header passes",
+TEST_CASE("GIVEN an 8000x8000 PNG WHEN read with the default cap THEN refused, and with a higher cap the header passes",
           "[io][image][reliability]") {
   TempFolder folder("big-png");
   const fs::path big = folder.path / "big.png";

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <thread>
 
 #include "../segmentation/fake_similarity.hpp"
@@ -52,7 +53,7 @@ TEST_CASE(
 
 TEST_CASE(
     "GIVEN motion samples from another thread saying the robot stands WHEN frames arrive THEN they are "
-    "skipped; "
+    "skipped, and "
     "once the samples stop, motion is unknown and frames are added again",
     "[pipeline][motion]") {
   const TableSimilarity similarity(blocks);
@@ -60,6 +61,14 @@ TEST_CASE(
   gate.standing_after_s = 1.0;
   gate.timeout_s = 0.5;
   FiedlerSegmentationStage stage(stageConfig(), similarity, 600, gate);
+  toposlam::MotionStatusCounters counters;
+  {
+    FiedlerSegmentationStage fresh(stageConfig(), similarity, 600, gate);
+    fresh.reportMotionTo(&counters);
+    fresh.process(0, 99.0, 99.0, fakeFingerprint(0), cv::Mat());  // no sample yet
+    CHECK(counters.use.load() == static_cast<int>(toposlam::MotionUse::None));
+  }
+  stage.reportMotionTo(&counters);
   std::thread feeder([&stage] {
     for (int i = 0; i <= 50; ++i) stage.addMotion(MotionSample{100.0 + 0.1 * i, 0.0, 0.0});  // 100 .. 105 s
   });
@@ -70,8 +79,14 @@ TEST_CASE(
     if (t >= 101.0 && t <= 105.5) {
       CHECK(stage.lastMotion().standing);
       CHECK(std::isnan(step.lambda2));
+      CHECK(counters.use.load() == static_cast<int>(toposlam::MotionUse::Used));
+      CHECK(counters.standing_frames.load() == stage.skippedFrames());
     }
   }
+  // The status message's view: the link went silent, 23 frames were left out.
+  CHECK(counters.use.load() == static_cast<int>(toposlam::MotionUse::Lost));
+  CHECK(counters.standing_frames.load() == 23);
+  CHECK(std::string(toposlam::toString(toposlam::MotionUse::Lost)) == "lost");
   CHECK(stage.skippedFrames() == 23);     // frames 5 .. 27 (101.0 .. 105.4 s)
   CHECK_FALSE(stage.lastMotion().known);  // 105.8 s: the newest sample is 0.8 s old
   CHECK(stage.refusedMotionSamples() == 0);

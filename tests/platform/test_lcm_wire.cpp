@@ -29,7 +29,7 @@ void putInt32(std::vector<std::uint8_t>& bytes, std::size_t at, std::int32_t v) 
 
 }  // namespace
 
-TEST_CASE("GIVEN encoded place, status and topology messages WHEN checked THEN they fit; lying lengths do not",
+TEST_CASE("GIVEN encoded place, status and topology messages WHEN checked THEN they fit, and lying lengths do not",
           "[platform][lcm][reliability]") {
   toposlam_lcm::place_t place{};
   place.num_alternatives = 2;

@@ -68,7 +68,7 @@ TEST_CASE(
 TEST_CASE(
     "GIVEN samples stop arriving WHEN timeout_s has passed THEN motion is unknown (link lost), and known "
     "again "
-    "after a new sample; the gap restarts the standing run",
+    "after a new sample, and the gap restarts the standing run",
     "[motion_gate]") {
   MotionGate gate(gateConfig());
   double t = 0.0;

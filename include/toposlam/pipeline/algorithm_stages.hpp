@@ -68,6 +68,9 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::int64_t skippedFrames() const { return segmenter_.skippedFrames(); }
   std::int64_t refusedMotionSamples() const { return gate_.rejectedSamples(); }
   std::int64_t droppedMotionSamples() const;
+  /// From now on, every frame writes whether motion is used and the standing frames so far into
+  /// `counters` (may be null: nowhere), which must outlive the stage; any thread may read them.
+  void reportMotionTo(MotionStatusCounters* counters) { motion_counters_ = counters; }
 
  private:
   /// The pipeline's record of a place the segmenter closed (nullopt when it was dropped); frees the
@@ -86,6 +89,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::deque<MotionSample> pending_motion_;  ///< guarded by motion_mutex_
   std::deque<MotionSample> applying_;        ///< segmentation thread: swapped out of pending_motion_
   std::int64_t dropped_motion_ = 0;          ///< guarded by motion_mutex_
+  MotionStatusCounters* motion_counters_ = nullptr;
 };
 
 /// TopologyParticleFilter with its step sliced into `slice_items` work items, run until the time budget

@@ -7,6 +7,7 @@
 // publisher thread only. None of them needs to be thread-safe.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -159,6 +160,25 @@ struct StageStatus {
   std::size_t queue_depth = 0;  ///< items waiting in its input queue now
   std::size_t queue_capacity = 0;
   double cpu_percent = 0.0;     ///< CPU time of the stage's thread over the last period (100 = one core)
+};
+
+/// Whether segmentation uses the robot's motion (docs/segmentation.md, "Motion-aware segmentation").
+enum class MotionUse : int {
+  None = 0,  ///< no motion sample has arrived: segmenting by time
+  Used = 1,  ///< samples are fresh: standing frames are skipped (and the window is in metres, if set)
+  Lost = 2,  ///< samples arrived, but none within the gate's timeout: segmenting by time again
+};
+/// "none", "used", "lost".
+inline const char* toString(MotionUse use) {
+  return use == MotionUse::Used ? "used" : use == MotionUse::Lost ? "lost" : "none";
+}
+
+/// Robot motion as the daemon sees it, for the status message: the LCM receive thread counts messages,
+/// the segmentation thread writes the rest, the publisher reads all three.
+struct MotionStatusCounters {
+  std::atomic<std::int64_t> messages{0};         ///< motion messages received
+  std::atomic<int> use{static_cast<int>(MotionUse::None)};  ///< a MotionUse, at the last frame
+  std::atomic<std::int64_t> standing_frames{0};  ///< frames left out of segmentation as standing
 };
 
 struct PipelineStatus {

@@ -156,15 +156,16 @@ int runDaemon(const DaemonConfig& config) {
 
   // Motion input: counted, and fed to the segmentation's MotionGate (docs/segmentation.md, "Motion-aware
   // segmentation"; motion_t.utime and the pipeline's SteadyClock are both CLOCK_MONOTONIC).
-  std::atomic<std::int64_t> motion_messages{0};
+  MotionStatusCounters motion_status;
   std::atomic<bool> receiving{true};
   const LcmChannels channels = channelsOf(config.lcm);
   FiedlerSegmentationStage& segmentation_stage = *parts.segmentation;
+  segmentation_stage.reportMotionTo(&motion_status);
   LcmSubscriber motion(config.lcm.url, channels, {channels.motion}, [&](const ReceivedMessage& m) {
-    motion_messages.fetch_add(1);
+    motion_status.messages.fetch_add(1);
     segmentation_stage.addMotion(MotionSample{m.motion_time_s, m.motion_distance_m, m.motion_speed_mps, m.motion_turn_rate_rps});
   });
-  LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_messages);
+  LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_status);
 
   Pipeline pipeline(pipeline_config, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink,
                     clock);
@@ -200,9 +201,12 @@ int runDaemon(const DaemonConfig& config) {
       // Says when the camera is reconnecting; a stalled stage (no heartbeat while inside its work) is named,
       // since that is also why the watchdog pings stop.
       const std::string stalled = pipeline.stalledStages();
-      notifier.status(stalled.empty() ? statusLine(pipeline.status())
-                                      : "stalled: " + stalled + " without progress (watchdog pings withheld); " +
-                                            statusLine(pipeline.status()));
+      std::string line = statusLine(pipeline.status());
+      // Robot motion, once any has arrived: whether segmentation uses it (docs/segmentation.md).
+      if (const auto use = static_cast<MotionUse>(motion_status.use.load()); use != MotionUse::None)
+        line += std::string("; motion ") + (use == MotionUse::Used ? "used" : "lost (segmenting by time)") + ", " +
+                std::to_string(motion_status.standing_frames.load()) + " standing frames skipped";
+      notifier.status(stalled.empty() ? line : "stalled: " + stalled + " without progress (watchdog pings withheld); " + line);
     }
   }
   // The end of the stream (a file or simulator source ran out) is a stop too: systemd hears STOPPING=1

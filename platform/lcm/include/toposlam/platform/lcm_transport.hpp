@@ -44,9 +44,9 @@ std::int64_t monotonicMicroseconds();
 
 class LcmPipelineSink final : public PipelineSink {
  public:
-  /// `motion_messages` (may be null) is reported in the status message.
+  /// `motion` (may be null: no motion input) is reported in the status message; it must outlive the sink.
   LcmPipelineSink(const std::string& url, LcmChannels channels, int jpeg_quality,
-                  const std::atomic<std::int64_t>* motion_messages = nullptr);
+                  const MotionStatusCounters* motion = nullptr);
   ~LcmPipelineSink() override;
   void publish(const FrameResult& result) override;
   void publishStatus(const PipelineStatus& status) override;
@@ -59,7 +59,7 @@ class LcmPipelineSink final : public PipelineSink {
   std::unique_ptr<lcm::LCM> lcm_;
   LcmChannels channels_;
   std::vector<int> jpeg_params_;
-  const std::atomic<std::int64_t>* motion_messages_;
+  const MotionStatusCounters* motion_;
   std::vector<std::uint8_t> buffer_;  ///< encoding scratch, grows to the largest message once
   std::vector<std::uint8_t> jpeg_;
   std::int64_t failures_ = 0;
