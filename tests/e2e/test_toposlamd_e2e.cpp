@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -153,11 +154,38 @@ bool contains(const std::vector<std::string>& lines, const std::string& text) {
   return false;
 }
 
-/// Representative frame of a place event, from its JSON.
-std::int64_t representativeOf(const ReceivedMessage& m) {
-  const std::string key = "\"representative_frame\":";
+/// An integer field of a message's JSON, -1 when absent.
+std::int64_t integerField(const ReceivedMessage& m, const std::string& name) {
+  const std::string key = "\"" + name + "\":";
   const std::size_t at = m.json.find(key);
   return at == std::string::npos ? -1 : std::stoll(m.json.substr(at + key.size()));
+}
+
+/// Representative frame of a place event, from its JSON.
+std::int64_t representativeOf(const ReceivedMessage& m) { return integerField(m, "representative_frame"); }
+
+/// One row of `toposlam map`'s places.csv: first, last, representative frame and node.
+struct OfflinePlace {
+  std::int64_t first = -1, last = -1, representative = -1, node = -1;
+};
+
+/// Runs `toposlam map URI --out DIR` (the offline data path) and reads its places.csv; empty on failure.
+std::vector<OfflinePlace> offlineMap(const std::string& uri, const fs::path& dir) {
+  const std::string command = std::string(TOPOSLAM_CLI_BINARY) + " map '" + uri + "' --out '" + dir.string() +
+                              "' > '" + (dir.string() + ".log") + "' 2>&1";
+  std::vector<OfflinePlace> places;
+  if (std::system(command.c_str()) != 0) return places;
+  std::ifstream in(dir / "places.csv");
+  std::string line;
+  std::getline(in, line);  // place,first,last,representative,keypoints,node
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    std::string cell;
+    std::vector<std::int64_t> v;
+    while (std::getline(row, cell, ',')) v.push_back(std::stoll(cell));
+    if (v.size() == 6) places.push_back(OfflinePlace{v[1], v[2], v[3], v[5]});
+  }
+  return places;
 }
 
 /// Place -> node of a TOPOSLAM_TOPOLOGY message, from its JSON ("nodes":[{"id":N,"places":[...]},...]).
@@ -310,6 +338,29 @@ SCENARIO("toposlamd maps the simulated two-traversal office and publishes it ove
       REQUIRE(second_places.size() >= 6);
       CHECK(closed >= static_cast<int>(second_places.size()) - 3);
       CHECK(wrong <= 1);
+    }
+    THEN("the daemon found the places and nodes that `toposlam map` finds offline on the same frames") {
+      // One data path (docs/architecture.md): the same segmenter and the same seeded filter, here sliced over
+      // frames on the topology thread, there stepped whole. Place borders, representatives and the final
+      // most probable topology must agree exactly.
+      const std::vector<OfflinePlace> offline = offlineMap(kRoute, freshDirectory("office-offline"));
+      REQUIRE_FALSE(offline.empty());
+      REQUIRE(heard.events.size() == offline.size());
+      for (std::size_t p = 0; p < offline.size(); ++p) {
+        INFO("place " << p);
+        CHECK(integerField(heard.events[p], "place") == static_cast<std::int64_t>(p));
+        CHECK(integerField(heard.events[p], "first_frame") == offline[p].first);
+        CHECK(integerField(heard.events[p], "last_frame") == offline[p].last);
+        CHECK(representativeOf(heard.events[p]) == offline[p].representative);
+      }
+      REQUIRE_FALSE(heard.topologies.empty());
+      const std::map<int, int> node_of_place = nodesOfPlaces(heard.topologies.back());
+      for (std::size_t p = 0; p < offline.size(); ++p) {
+        INFO("place " << p);
+        const auto it = node_of_place.find(static_cast<int>(p));
+        REQUIRE(it != node_of_place.end());
+        CHECK(it->second == offline[p].node);
+      }
     }
   }
 }
