@@ -4,11 +4,13 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "fake_similarity.hpp"
+#include "toposlam/eval/run_files.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
 
 using toposlam::test::fakeFingerprint;
@@ -83,5 +85,38 @@ TEST_CASE(
     CHECK(plot.vertical_lines[0].value == 39.5);
     CHECK(plot.vertical_lines[1].value == 79.5);
     CHECK(plot.horizontal_lines.at(0).value == 0.5);
+  }
+}
+
+TEST_CASE(
+    "GIVEN frame names with commas, quotes and line breaks WHEN frames.csv is written and read back by eval THEN "
+    "every name and column survives",
+    "[segmentation][run][reliability]") {
+  toposlam::SegmentationRun run;
+  const std::vector<std::string> names = {"plain.jpg", "a,b.jpg", "say \"hi\".jpg", "two\nlines.jpg", "cr\r\nlf.jpg",
+                                          ",\",\n"};
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    toposlam::SegmentationFrameRecord row;
+    row.frame = static_cast<std::int64_t>(f);
+    row.time_s = 0.25 * static_cast<double>(f);
+    row.name = names[f];
+    row.lambda2 = 0.5;
+    row.place = 0;
+    run.frames.push_back(row);
+  }
+  const std::string path = std::string(TOPOSLAM_BINARY_DIR) + "/frames-quoted-names.csv";
+  {
+    std::ofstream out(path, std::ios::binary);
+    toposlam::writeFramesCsv(out, run, {3});
+  }
+  const std::vector<toposlam::eval::FrameRecord> back = toposlam::eval::loadFrames(path);
+  REQUIRE(back.size() == names.size());
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    INFO("frame " << f);
+    CHECK(back[f].frame == static_cast<std::int64_t>(f));
+    CHECK(back[f].name == names[f]);
+    CHECK(back[f].time_s == Approx(0.25 * static_cast<double>(f)));
+    CHECK(back[f].place == 0);
+    CHECK(back[f].node == 3);
   }
 }
