@@ -12,6 +12,7 @@
 
 #include "topology/fake_similarity.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/firmware/emulator.hpp"
 #include "toposlam/topology/map_store.hpp"
 #include "toposlam_lcm/motion_t.hpp"
 #include "toposlam_lcm/place_event_t.hpp"
@@ -103,5 +104,34 @@ int main(int argc, char** argv) {
   topology.nodes[0].representative_frames = {3};
   write(out / "lcm_messages" / "topology", encoded('\3', topology));
   write(out / "lcm_messages" / "motion", encoded('\4', toposlam_lcm::motion_t{}));
+  // Controller links: 1.5 s of each emulated message set (byte 0: protocol, byte 1: piece sizes), clean
+  // and damaged.
+  {
+    using namespace toposlam::firmware;
+    const struct {
+      const char* name;
+      EmulatedMessages messages;
+      char protocol;
+      double damage;
+    } links[] = {{"wheel-odometry", EmulatedMessages::WheelOdometry, '\0', 0.0},
+                 {"wheel-body-velocity-damaged", EmulatedMessages::BodyVelocity, '\0', 0.1},
+                 {"mavlink-odometry", EmulatedMessages::MavlinkOdometry, '\1', 0.0},
+                 {"mavlink-local-position-damaged", EmulatedMessages::MavlinkLocalPosition, '\1', 0.1}};
+    for (const auto& l : links) {
+      EmulatorConfig c;
+      c.messages = l.messages;
+      c.rate_hz = 20;
+      c.profile = {{0.75, 0.5, 0.2}, {0.75, 0.0, 0.0}};
+      c.corrupt_probability = l.damage;
+      c.garbage_probability = l.damage;
+      c.other_mavlink_traffic = l.protocol == '\1';
+      ControllerEmulator emulator(c);
+      std::vector<std::uint8_t> bytes;
+      emulator.advanceTo(emulator.duration(), bytes);
+      std::string seed{l.protocol, '\x11'};
+      seed.append(bytes.begin(), bytes.end());
+      write(out / "firmware_link" / l.name, seed);
+    }
+  }
   return 0;
 }
