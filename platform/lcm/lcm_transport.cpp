@@ -370,7 +370,8 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       out.node = m.node;
       out.place = m.place;
       out.is_new = m.is_new;
-      w.field("utime", m.utime).field("frame", m.frame).field("place", m.place).field("node", m.node);
+      w.field("utime", m.utime).field("publish_utime", m.publish_utime).field("frame", m.frame)
+          .field("place", m.place).field("node", m.node);
       jsonNumber(w, "probability", m.probability);
       w.field("is_new", m.is_new != 0);
       jsonNumber(w, "lambda2", m.lambda2);
