@@ -295,6 +295,8 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     s.integer("window", c.segmentation.window, 3, 1000, " frames");
     s.integer("min_window_frames", c.segmentation.min_window_frames, 3, 1000, " frames (and <= window)");
     s.real("window_m", c.segmentation.window_m, 0, 1000, " metres (0 = off: no window in distance)");
+    s.real("min_frame_spacing_m", c.segmentation.min_frame_spacing_m, 0, 100, " metres (0 = off)");
+    s.real("min_frame_spacing_rad", c.segmentation.min_frame_spacing_rad, 0, 10, " rad");
     Section mo = s.child("motion");
     mo.real("standing_speed_mps", c.segmentation_motion.standing_speed_mps, 0, 10, " m/s");
     mo.real("standing_turn_rate_rps", c.segmentation_motion.standing_turn_rate_rps, 0, 100, " rad/s");

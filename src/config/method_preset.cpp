@@ -17,6 +17,8 @@ MethodPreset methodPreset(const std::string& name) {
     p.segmentation.window_s = 6.0;
     p.segmentation.window = 100;
     p.segmentation.min_window_frames = 5;
+    p.segmentation.min_frame_spacing_m = 0.09;  // with motion and window_m only (docs/segmentation.md)
+    p.segmentation.min_frame_spacing_rad = 0.03;
     p.topology.likelihood = LikelihoodModel::Relative;
     p.topology.relative_slope = 2.0;
     p.topology.relative_offset = 8.0;
@@ -29,6 +31,8 @@ MethodPreset methodPreset(const std::string& name) {
     p.segmentation.similarity_floor = 0.0;
     p.segmentation.min_keypoints = 15;
     p.segmentation.cut_placement = CutPlacement::ValleyFrame;
+    p.segmentation.min_frame_spacing_m = 0.0;  // every frame (no motion in the thesis' pipeline)
+    p.segmentation.min_frame_spacing_rad = 0.0;
     p.topology.likelihood = LikelihoodModel::Absolute;
     p.topology.particles = 500;
     p.topology.alpha = 15.0;

@@ -88,6 +88,16 @@ std::string FiedlerSegmenterConfig::validate() const {
   if (min_keypoints < 0 || min_keypoints > 100000) {
     return "min_keypoints: " + std::to_string(min_keypoints) + " is outside the allowed range [0, 100000]";
   }
+  if (!(min_frame_spacing_m >= 0.0 && min_frame_spacing_m <= 100.0)) {
+    std::ostringstream message;
+    message << "min_frame_spacing_m: " << min_frame_spacing_m << " m is outside the allowed range [0, 100] (0 = off)";
+    return message.str();
+  }
+  if (!(min_frame_spacing_rad >= 0.0 && min_frame_spacing_rad <= 10.0)) {
+    std::ostringstream message;
+    message << "min_frame_spacing_rad: " << min_frame_spacing_rad << " rad is outside the allowed range [0, 10]";
+    return message.str();
+  }
   if (cut_placement != CutPlacement::WindowSplit && cut_placement != CutPlacement::ValleyFrame) {
     return "cut_placement: unknown value (allowed: window-split, valley-frame)";
   }
@@ -274,6 +284,23 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
   }
   const double distance_m =
       std::isfinite(motion.distance_m) ? motion.distance_m : std::numeric_limits<double>::quiet_NaN();
+  // Too close to the last frame added, in travel and in heading: left out (a frame that breaks the rules
+  // still reaches addFrameAt and its errors).
+  if (config_.window_m > 0.0 && config_.min_frame_spacing_m > 0.0 && std::isfinite(distance_m) &&
+      std::isfinite(last_added_distance_m_) && distance_m >= last_added_distance_m_ &&
+      distance_m - last_added_distance_m_ < config_.min_frame_spacing_m &&
+      motion.turned_rad - last_added_turned_rad_ < config_.min_frame_spacing_rad && frame_index > last_frame_ &&
+      fingerprint) {
+    ++thinned_frames_;
+    SegmenterStep step;
+    step.frame = frame_index;
+    step.skipped = true;
+    return step;
+  }
+  if (std::isfinite(distance_m)) {
+    last_added_distance_m_ = distance_m;
+    last_added_turned_rad_ = motion.turned_rad;
+  }
   return addFrameAt(frame_index, time_s, std::move(fingerprint), distance_m);
 }
 

@@ -40,6 +40,7 @@ bool MotionGate::addSample(double time_s, double distance_increment_m, double sp
   if (slow && (!slow_ || gap || samples_ == 0)) slow_since_s_ = time_s;
   slow_ = slow;
   distance_m_ += std::abs(distance_increment_m);
+  if (samples_ > 0 && !gap) turned_rad_ += std::abs(turn_rate_rps) * (time_s - last_time_s_);
   last_time_s_ = time_s;
   ++samples_;
   return true;
@@ -50,6 +51,7 @@ MotionState MotionGate::at(double time_s) const {
   if (samples_ == 0 || !std::isfinite(time_s) || time_s - last_time_s_ > config_.timeout_s) return state;
   state.known = true;
   state.distance_m = distance_m_;
+  state.turned_rad = turned_rad_;
   state.standing = slow_ && time_s - slow_since_s_ >= config_.standing_after_s;
   return state;
 }

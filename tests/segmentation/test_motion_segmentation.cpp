@@ -84,6 +84,7 @@ struct Result {
   std::vector<SegmentedPlace> places;
   std::vector<std::optional<double>> lambda2;
   std::int64_t skipped = 0;
+  std::int64_t thinned = 0;
 };
 
 /// Segments the route; with `gate`, motion samples (one per frame, at the frame's time) go through it.
@@ -109,6 +110,7 @@ Result segment(const std::vector<RouteFrame>& frames, const FiedlerSegmenterConf
   }
   if (auto last = segmenter.flush()) r.places.push_back(*last);
   r.skipped = segmenter.skippedFrames();
+  r.thinned = segmenter.thinnedFrames();
   return r;
 }
 
@@ -217,4 +219,59 @@ TEST_CASE("GIVEN window_m out of range WHEN validated THEN the key and range are
   CHECK(c.validate().find("window_m") == 0);
   c.window_m = 1.75;
   CHECK(c.validate().empty());
+}
+
+TEST_CASE(
+    "GIVEN a route with a stretch at a third of the speed WHEN segmented with motion and a frame spacing THEN "
+    "the slow frames are thinned to the steady density and no frame of the steady route is",
+    "[segmentation][motion]") {
+  const int rooms = 4;
+  // 0.5 m/s at 5 fps: 0.1 m per frame; the slow stretch (8 to 14 m, in room 1 and 2): 0.033 m per frame.
+  const std::vector<RouteFrame> steady = route(rooms, 0.5, {});
+  const std::vector<RouteFrame> slow = route(rooms, 0.5, {}, {8.0, 14.0});
+  FiedlerSegmenterConfig c = timeConfig();
+  c.window_m = 3.0;
+  c.min_frame_spacing_m = 0.09;
+  c.min_frame_spacing_rad = 0.03;
+  MotionGate steady_gate(gateConfig()), slow_gate(gateConfig());
+  const Result a = segment(steady, c, &steady_gate);
+  const Result b = segment(slow, c, &slow_gate);
+  CHECK(a.thinned == 0);
+  // 6 m at 0.033 m per frame: 180 frames, of which every third is kept.
+  CHECK(b.thinned == Approx(120).margin(3));
+  CHECK(b.skipped == 0);  // thinned frames are not counted as standing
+  // The same places, with borders at the same positions (within one steady frame of travel).
+  REQUIRE(a.places.size() == b.places.size());
+  for (std::size_t p = 1; p < a.places.size(); ++p) {
+    const double xa = steady[static_cast<std::size_t>(a.places[p].first_frame)].position_m;
+    const double xb = slow[static_cast<std::size_t>(b.places[p].first_frame)].position_m;
+    CHECK(xb == Approx(xa).margin(0.15));
+  }
+  // Off (0 m): every frame is added.
+  c.min_frame_spacing_m = 0.0;
+  MotionGate off_gate(gateConfig());
+  CHECK(segment(slow, c, &off_gate).thinned == 0);
+}
+
+TEST_CASE("GIVEN a robot turning on the spot WHEN its frames are spaced THEN they are kept while the heading changes",
+          "[segmentation][motion]") {
+  FiedlerSegmenterConfig c = timeConfig();
+  c.window_m = 3.0;
+  c.min_frame_spacing_m = 0.09;
+  c.min_frame_spacing_rad = 0.03;
+  const TableSimilarity similarity([](int, int) { return 0.5; });
+  FiedlerSegmenter segmenter(c, similarity);
+  MotionGate gate(gateConfig());
+  // 2 s of turning at 0.5 rad/s without moving (0.1 rad per frame), then 2 s at 0.01 rad/s (0.002 rad).
+  for (int i = 0; i < 20; ++i) {
+    const double t = 0.2 * i;
+    const double rate = i < 10 ? 0.5 : 0.01;
+    gate.addSample(t, 0.0, 0.0, rate);
+    segmenter.addFrame(i, t, fakeFingerprint(i), gate.at(t));
+  }
+  CHECK(gate.at(3.8).turned_rad == Approx(10 * 0.2 * 0.5 - 0.2 * 0.5 + 0.2 * 0.01 * 10).margin(1e-9));
+  // Turning: no frame thinned (the first is added, each next one is 0.1 rad on). Creeping round: thinned
+  // until 0.03 rad have gathered, or standing (below both standing thresholds for 1 s).
+  CHECK(segmenter.thinnedFrames() + segmenter.skippedFrames() >= 8);
+  CHECK(segmenter.windowFrames() >= 10);
 }

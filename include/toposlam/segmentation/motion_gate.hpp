@@ -39,6 +39,7 @@ struct MotionState {
   bool known = false;  ///< a sample within timeout_s (link alive); false: segment by time as without motion
   bool standing = false;    ///< known, slower than standing_speed_mps and not turning, for standing_after_s or more
   double distance_m = 0.0;  ///< travelled since the first sample (meaningful only when known)
+  double turned_rad = 0.0;  ///< |yaw| turned since the first sample, integrated from the yaw rate
 };
 
 class MotionGate {
@@ -65,6 +66,7 @@ class MotionGate {
   std::int64_t rejected_ = 0;
   double last_time_s_ = 0.0;
   double distance_m_ = 0.0;
+  double turned_rad_ = 0.0;
   bool slow_ = false;          ///< the newest sample was below standing_speed_mps and not turning
   double slow_since_s_ = 0.0;  ///< time of the first sample of the current slow run
 };

@@ -2,7 +2,6 @@
 #include "motion_input.hpp"
 
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
