@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -62,19 +63,21 @@ double maxFiedlerValue(int nodes) {
 }
 
 std::string FiedlerSegmenterConfig::validate() const {
+  // "<key>: <value><unit> is outside the allowed range [lo, hi]<note>" for a real outside [lo, hi] (or NaN).
+  const auto outside = [](const char* key, double value, double lo, double hi, const char* unit,
+                          const char* note) -> std::optional<std::string> {
+    if (value >= lo && value <= hi) return std::nullopt;
+    std::ostringstream message;
+    message << key << ": " << value << unit << " is outside the allowed range [" << lo << ", " << hi << "]" << note;
+    return message.str();
+  };
   if (window < 3 || window > 1000) {
     return "window: " + std::to_string(window) + " frames is outside the allowed range [3, 1000]";
   }
-  if (!(window_s >= 0.0 && window_s <= 3600.0)) {
-    std::ostringstream message;
-    message << "window_s: " << window_s << " s is outside the allowed range [0, 3600] (0 = count frames)";
-    return message.str();
-  }
-  if (!(window_m >= 0.0 && window_m <= 1000.0)) {
-    std::ostringstream message;
-    message << "window_m: " << window_m << " m is outside the allowed range [0, 1000] (0 = off)";
-    return message.str();
-  }
+  if (auto p = outside("window_s", window_s, 0, 3600, " s", " (0 = count frames)")) return *p;
+  if (auto p = outside("window_m", window_m, 0, 1000, " m", " (0 = off)")) return *p;
+  if (auto p = outside("min_frame_spacing_m", min_frame_spacing_m, 0, 100, " m", " (0 = off)")) return *p;
+  if (auto p = outside("min_frame_spacing_rad", min_frame_spacing_rad, 0, 10, " rad", "")) return *p;
   if (min_window_frames < 3 || min_window_frames > window) {
     return "min_window_frames: " + std::to_string(min_window_frames) + " is outside the allowed range [3, window = " +
            std::to_string(window) + "]";
@@ -87,16 +90,6 @@ std::string FiedlerSegmenterConfig::validate() const {
   }
   if (min_keypoints < 0 || min_keypoints > 100000) {
     return "min_keypoints: " + std::to_string(min_keypoints) + " is outside the allowed range [0, 100000]";
-  }
-  if (!(min_frame_spacing_m >= 0.0 && min_frame_spacing_m <= 100.0)) {
-    std::ostringstream message;
-    message << "min_frame_spacing_m: " << min_frame_spacing_m << " m is outside the allowed range [0, 100] (0 = off)";
-    return message.str();
-  }
-  if (!(min_frame_spacing_rad >= 0.0 && min_frame_spacing_rad <= 10.0)) {
-    std::ostringstream message;
-    message << "min_frame_spacing_rad: " << min_frame_spacing_rad << " rad is outside the allowed range [0, 10]";
-    return message.str();
   }
   if (cut_placement != CutPlacement::WindowSplit && cut_placement != CutPlacement::ValleyFrame) {
     return "cut_placement: unknown value (allowed: window-split, valley-frame)";
@@ -266,32 +259,29 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
   return addFrameAt(frame_index, time_s, std::move(fingerprint), std::numeric_limits<double>::quiet_NaN());
 }
 
+void FiedlerSegmenter::checkNextFrame(std::int64_t frame_index, const Fingerprint* fingerprint) const {
+  if (fingerprint == nullptr) throw std::invalid_argument("FiedlerSegmenter::addFrame: null fingerprint");
+  if (frame_index <= last_frame_) {
+    throw std::invalid_argument("FiedlerSegmenter::addFrame: frame " + std::to_string(frame_index) +
+                                " does not follow frame " + std::to_string(last_frame_) +
+                                " (frame indices must increase)");
+  }
+}
+
 SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s,
                                          std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
   if (!motion.known) return addFrame(frame_index, time_s, std::move(fingerprint));
-  if (motion.standing) {
-    if (!fingerprint) throw std::invalid_argument("FiedlerSegmenter::addFrame: null fingerprint");
-    if (frame_index <= last_frame_) {
-      throw std::invalid_argument("FiedlerSegmenter::addFrame: frame " + std::to_string(frame_index) +
-                                  " does not follow frame " + std::to_string(last_frame_) +
-                                  " (frame indices must increase)");
-    }
-    ++skipped_frames_;
-    SegmenterStep step;
-    step.frame = frame_index;
-    step.skipped = true;
-    return step;
-  }
   const double distance_m =
       std::isfinite(motion.distance_m) ? motion.distance_m : std::numeric_limits<double>::quiet_NaN();
-  // Too close to the last frame added, in travel and in heading: left out (a frame that breaks the rules
-  // still reaches addFrameAt and its errors).
-  if (config_.window_m > 0.0 && config_.min_frame_spacing_m > 0.0 && std::isfinite(distance_m) &&
-      std::isfinite(last_added_distance_m_) && distance_m >= last_added_distance_m_ &&
-      distance_m - last_added_distance_m_ < config_.min_frame_spacing_m &&
-      motion.turned_rad - last_added_turned_rad_ < config_.min_frame_spacing_rad && frame_index > last_frame_ &&
-      fingerprint) {
-    ++thinned_frames_;
+  // Left out: the robot stands, or (frame spacing) the frame is too close to the last one added, in
+  // travel and in heading.
+  const bool too_close = config_.window_m > 0.0 && config_.min_frame_spacing_m > 0.0 && std::isfinite(distance_m) &&
+                         std::isfinite(last_added_distance_m_) && distance_m >= last_added_distance_m_ &&
+                         distance_m - last_added_distance_m_ < config_.min_frame_spacing_m &&
+                         motion.turned_rad - last_added_turned_rad_ < config_.min_frame_spacing_rad;
+  if (motion.standing || too_close) {
+    checkNextFrame(frame_index, fingerprint.get());
+    ++(motion.standing ? skipped_frames_ : thinned_frames_);
     SegmenterStep step;
     step.frame = frame_index;
     step.skipped = true;
@@ -306,12 +296,7 @@ SegmenterStep FiedlerSegmenter::addFrame(std::int64_t frame_index, double time_s
 
 SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time_s,
                                            std::shared_ptr<const Fingerprint> fingerprint, double distance_m) {
-  if (!fingerprint) throw std::invalid_argument("FiedlerSegmenter::addFrame: null fingerprint");
-  if (frame_index <= last_frame_) {
-    throw std::invalid_argument("FiedlerSegmenter::addFrame: frame " + std::to_string(frame_index) +
-                                " does not follow frame " + std::to_string(last_frame_) +
-                                " (frame indices must increase)");
-  }
+  checkNextFrame(frame_index, fingerprint.get());
   // ValleyFrame: the border after a recorded minimum is the frame that follows it.
   if (pending_min_frame_ >= 0 && pending_min_frame_ == last_frame_ && pending_border_frame_ < 0 &&
       config_.cut_placement == CutPlacement::ValleyFrame) {

@@ -268,10 +268,17 @@ TEST_CASE("GIVEN a robot turning on the spot WHEN its frames are spaced THEN the
     const double rate = i < 10 ? 0.5 : 0.01;
     gate.addSample(t, 0.0, 0.0, rate);
     segmenter.addFrame(i, t, fakeFingerprint(i), gate.at(t));
+    if (i == 9) {
+      // Turning: every frame is 0.1 rad on from the one before, so none is thinned.
+      CHECK(segmenter.thinnedFrames() == 0);
+      CHECK(segmenter.windowFrames() == 10);
+    }
   }
-  CHECK(gate.at(3.8).turned_rad == Approx(10 * 0.2 * 0.5 - 0.2 * 0.5 + 0.2 * 0.01 * 10).margin(1e-9));
-  // Turning: no frame thinned (the first is added, each next one is 0.1 rad on). Creeping round: thinned
-  // until 0.03 rad have gathered, or standing (below both standing thresholds for 1 s).
-  CHECK(segmenter.thinnedFrames() + segmenter.skippedFrames() >= 8);
-  CHECK(segmenter.windowFrames() >= 10);
+  // The gate integrates |yaw rate| over each interval: 9 x 0.1 + 10 x 0.002 rad.
+  CHECK(gate.at(3.8).turned_rad == Approx(0.92).margin(1e-9));
+  // Creeping round from frame 10: less than 0.03 rad per frame from the last frame added, so thinned,
+  // until the creep has lasted standing_after_s (1 s from 2.0 s): frames 15-19 stand instead.
+  CHECK(segmenter.thinnedFrames() == 5);
+  CHECK(segmenter.skippedFrames() == 5);
+  CHECK(segmenter.windowFrames() == 10);
 }

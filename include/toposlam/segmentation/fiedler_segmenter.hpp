@@ -177,6 +177,8 @@ class FiedlerSegmenter {
   /// The representative preference of the header comment: true when `a` is the better candidate.
   bool preferred(const Candidate& a, const Candidate& b) const;
 
+  /// Throws std::invalid_argument for a null fingerprint or a frame index that does not increase.
+  void checkNextFrame(std::int64_t frame_index, const Fingerprint* fingerprint) const;
   /// addFrame with the distance travelled at the frame (NaN = motion unknown).
   SegmenterStep addFrameAt(std::int64_t frame_index, double time_s, std::shared_ptr<const Fingerprint> fingerprint,
                            double distance_m);

@@ -204,8 +204,8 @@ int runDaemon(const DaemonConfig& config) {
       std::string line = statusLine(pipeline.status());
       // Robot motion, once any has arrived: whether segmentation uses it (docs/segmentation.md).
       if (const auto use = static_cast<MotionUse>(motion_status.use.load()); use != MotionUse::None)
-        line += std::string("; motion ") + (use == MotionUse::Used ? "used" : "lost (segmenting by time)") + ", " +
-                std::to_string(motion_status.standing_frames.load()) + " standing frames skipped";
+        line += std::string("; motion ") + toString(use) + (use == MotionUse::Lost ? " (segmenting by time)" : "") +
+                ", " + std::to_string(motion_status.standing_frames.load()) + " standing frames skipped";
       notifier.status(stalled.empty() ? line : "stalled: " + stalled + " without progress (watchdog pings withheld); " + line);
     }
   }
