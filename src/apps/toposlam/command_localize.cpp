@@ -7,6 +7,10 @@
 // place with several reference fingerprints. Bad lines and unreadable images are reported on stderr as
 // "file:line: problem" and skipped; the command fails only when no place or no query is usable. A path
 // holding a comma is written in double quotes (RFC 4180), and --out quotes its fields the same way.
+//
+// --route: the queries are one traversal in file order and the places are in route order (the order of
+// their labels' first appearance), so each query's place probabilities are filtered along the route
+// (PlaceRouteFilter: stay or move on to the next place); the printed probability is the filtered one.
 #include <algorithm>
 #include <fstream>
 #include <iomanip>
@@ -23,6 +27,7 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/labelled_image_list.hpp"
 #include "toposlam/matching/place_localizer.hpp"
+#include "toposlam/matching/place_route_filter.hpp"
 #include "toposlam/matching/similarity_preset.hpp"
 
 namespace toposlam::cli {
@@ -38,6 +43,8 @@ struct LocalizeOptions {
   bool normalise_counts = false;
   bool json = false;
   std::string preset = "default";
+  bool route = false;
+  PlaceRouteFilterConfig route_filter;
 };
 
 struct Prediction {
@@ -46,6 +53,7 @@ struct Prediction {
   std::string predicted;  ///< label of the most probable place
   double probability = 0.0;
   bool correct = false;
+  std::vector<double> probabilities;  ///< every place's, in place order (JSON only)
 };
 
 struct ThresholdRow {
@@ -132,6 +140,9 @@ void runLocalize(const LocalizeOptions& o) {
   config.normalise_counts = o.normalise_counts;
   const PlaceLocalizer localizer(config, std::move(places));
 
+  std::optional<PlaceRouteFilter> route;
+  if (o.route) route.emplace(o.route_filter, localizer.placeCount());
+
   std::vector<Prediction> predictions;
   int unknown_labels = 0;
   const Progress query_progress("queries", query_list.images.size());
@@ -142,8 +153,10 @@ void runLocalize(const LocalizeOptions& o) {
       Prediction p;
       p.image = entry.path;
       p.expected = entry.label;
-      p.predicted = localizer.place(l.best_place).label;
-      p.probability = l.best_probability;
+      p.probabilities = route ? route->update(l.probabilities) : l.probabilities;
+      const auto best = std::max_element(p.probabilities.begin(), p.probabilities.end());
+      p.predicted = localizer.place(static_cast<int>(best - p.probabilities.begin())).label;
+      p.probability = *best;
       p.correct = p.predicted == p.expected;
       if (place_index.count(entry.label) == 0) ++unknown_labels;
       predictions.push_back(std::move(p));
@@ -179,21 +192,30 @@ void runLocalize(const LocalizeOptions& o) {
     json.beginObject().field("places", localizer.placeCount()).field("place_images", static_cast<int>(place_list.images.size()));
     json.field("queries", static_cast<int>(predictions.size())).field("problems", problems);
     json.field("correct", static_cast<int>(all_correct)).field("precision", all_precision).field("chance", chance);
+    json.field("route", route.has_value());
     json.key("thresholds").beginArray();
     for (const ThresholdRow& r : rows)
       json.beginObject().field("threshold", r.threshold).field("images", r.reached).field("correct", r.correct)
           .field("precision", r.precision()).endObject();
     json.endArray();
     json.key("predictions").beginArray();
-    for (const Prediction& p : predictions)
+    for (const Prediction& p : predictions) {
       json.beginObject().field("image", p.image).field("expected", p.expected).field("label", p.predicted)
-          .field("probability", p.probability).field("correct", p.correct).endObject();
+          .field("probability", p.probability).field("correct", p.correct);
+      json.key("probabilities").beginArray();
+      for (double v : p.probabilities) json.value(v);
+      json.endArray().endObject();
+    }
     json.endArray().endObject();
     std::cout << "\n";
     return;
   }
   std::cout << localizer.placeCount() << " places, " << predictions.size() << " queries localised ("
-            << problems << " problems)\n";
+            << problems << " problems)";
+  if (route)
+    std::cout << ", along the route (stay " << o.route_filter.stay_probability << ", jump "
+              << o.route_filter.jump_weight << (o.route_filter.loop ? ", loop" : "") << ")";
+  std::cout << "\n";
   std::cout << std::fixed << std::setprecision(2) << "all queries: " << all_correct << " correct, precision "
             << 100.0 * all_precision << "% (chance " << 100.0 * chance << "%)\n";
   std::cout << std::right << std::setw(10) << "Threshold" << std::setw(10) << "Images" << std::setw(12) << "Precision"
@@ -227,7 +249,26 @@ void addLocalizeCommand(CLI::App& app) {
   cmd->add_flag("--json", options->json, "Print JSON instead of the table");
   cmd->add_option("--preset", options->preset, "Method preset: default (measured on real frames) or thesis")
       ->capture_default_str();
-  cmd->callback([options] { runLocalize(*options); });
+  cmd->add_flag("--route", options->route,
+                "Queries are one traversal in file order through the places in route order (file order): "
+                "filter each query's place probabilities along the route");
+  cmd->add_option("--stay", options->route_filter.stay_probability,
+                  "With --route: probability of staying in the place between two queries (the rest: the next place)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--jump", options->route_filter.jump_weight,
+                  "With --route: weight of moving to any place off the route (relocalisation)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  cmd->add_flag("!--no-loop", options->route_filter.loop,
+                "With --route: the route is not a loop (the last place is not followed by the first)");
+  cmd->callback([options] {
+    if (!options->route && (options->route_filter.stay_probability != PlaceRouteFilterConfig{}.stay_probability ||
+                            options->route_filter.jump_weight != PlaceRouteFilterConfig{}.jump_weight ||
+                            !options->route_filter.loop))
+      throw std::invalid_argument("localize: --stay, --jump and --no-loop need --route");
+    runLocalize(*options);
+  });
 }
 
 }  // namespace toposlam::cli
