@@ -28,6 +28,7 @@ struct MatchingBenchOptions {
   int height = 480;
   std::vector<std::string> backends = {"orb"};
   std::vector<std::string> presets = {"default", "thesis"};
+  std::vector<int> budgets;  ///< keypoints per frame to measure; empty: the preset's
 };
 
 void runMatchingBench(const MatchingBenchOptions& o) {
@@ -40,11 +41,17 @@ void runMatchingBench(const MatchingBenchOptions& o) {
   std::cout << std::left << std::setw(16) << "preset kp" << std::right << std::setw(10) << "pairs" << std::setw(14)
             << "keypoints/f" << std::setw(13) << "letters/f" << std::setw(13) << "median us" << std::setw(10)
             << "p99 us" << std::setw(16) << "median sim/s" << std::setw(14) << "worst sim/s" << "\n";
+  const std::vector<int> budgets = o.budgets.empty() ? std::vector<int>{-1} : o.budgets;
   for (const std::string& preset_name : o.presets)
+  for (const int budget : budgets)
   for (const std::string& backend : o.backends) {
     const SimilarityPreset preset = similarityPreset(preset_name);
     VpackConfig config = preset.fingerprint;
     config.keypoints.backend = parseKeypointBackend(backend);
+    if (budget > 0) {
+      config.keypoints.max_keypoints = budget;
+      config.keypoints.candidate_limit = std::max(config.keypoints.candidate_limit, budget);
+    }
     const VpackExtractor extractor(config);
     std::vector<Fingerprint> prints;
     double keypoints = 0, letters = 0;
@@ -103,6 +110,8 @@ void addBenchMatching(CLI::App& bench) {
   cmd->add_option("--preset", options->presets, "Presets to measure (default, thesis)")->capture_default_str();
   cmd->add_option("--keypoints", options->backends, "Backends to measure (orb, sift, brisk, akaze)")
       ->capture_default_str();
+  cmd->add_option("--max-keypoints", options->budgets, "Keypoint budgets per frame to measure (default: the preset's)")
+      ->check(CLI::Range(1, 5000));
   cmd->callback([options] { runMatchingBench(*options); });
 }
 
