@@ -12,6 +12,7 @@
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "toposlam/io/sim_source.hpp"
+#include "source_modules.hpp"
 
 namespace toposlam {
 
@@ -95,10 +96,17 @@ std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
                                             given);
 }
 
+// video: lives in a module loaded on first use (source_modules.hpp; platform/video).
 std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
   uri.requireOnly({});
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': video: needs a file");
-  return std::make_unique<VideoFileSource>(uri.path, uri.getDouble("rate", 0.0, 1e-3, 1e4));
+  const double rate = uri.getDouble("rate", 0.0, 1e-3, 1e4);
+  using Open = FrameSource* (*)(const char*, double, std::string*);
+  const auto open = reinterpret_cast<Open>(sourceModuleSymbol("video", "toposlam_source_video_open_v1"));
+  std::string error;
+  std::unique_ptr<FrameSource> source(open(uri.path.c_str(), rate, &error));
+  if (!source) throw FrameSourceError(error);
+  return source;
 }
 
 std::unique_ptr<FrameSource> openSim(const SourceUri& uri) { return std::make_unique<SimFrameSource>(simConfigFromUri(uri)); }

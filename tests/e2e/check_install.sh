@@ -20,6 +20,16 @@ done
 grep -q "^ExecStart=/usr/sbin/toposlamd\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
   || fail "the unit installed with --prefix /usr does not start /usr/sbin/toposlamd"
 "$dest/pkg/usr/sbin/toposlamd" --check-config -c "$dest/pkg/etc/toposlam/toposlam.yaml"
+# The video module (loaded on first use) is installed beside the programs, and the installed program
+# loads that copy, not the build tree's.
+module=$(find "$dest/pkg/usr/lib" -name toposlam-source-video.so)
+[ -n "$module" ] || fail "missing after install --prefix /usr: the video module toposlam-source-video.so"
+if command -v ffmpeg >/dev/null; then
+  ffmpeg -loglevel error -f lavfi -i testsrc=size=96x64:rate=5 -t 1 -y "$dest/clip.mp4"
+  LD_DEBUG=files "$dest/pkg/usr/bin/toposlam" segment "video:$dest/clip.mp4" --out "$dest/seg" >"$dest/ld.log" 2>&1 \
+    || { cat "$dest/ld.log"; fail "the installed toposlam could not segment a video"; }
+  grep -q "file=$module " "$dest/ld.log" || fail "the installed toposlam did not load the installed video module $module"
+fi
 
 # 2. A private prefix: everything under it, the unit pointing at its binary.
 cmake --install "$build" --prefix "$dest/local" >/dev/null

@@ -1,4 +1,5 @@
-// Frame sources over files: an image folder or glob, played in natural order, and a video file.
+// Frame sources over files: an image folder or glob, played in natural order. (Video files: platform/video,
+// a module loaded on first use.)
 // Bad files (unreadable, truncated, undecodable) are skipped, counted and logged; the stream goes on.
 // Not thread-safe: one consumer calls next(); interrupt() (ends the stream early) from any thread.
 #pragma once
@@ -9,8 +10,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/videoio.hpp>
 
 #include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/image_file.hpp"
@@ -52,28 +51,6 @@ class ImageFilesSource : public FrameSource {
   std::vector<double> times_;    ///< per file, from timestamps.csv beside the files; empty = index / rate
   std::string timestamps_file_;  ///< that file, for describe()
   std::size_t next_index_ = 0;
-  std::int64_t skipped_ = 0;
-  std::atomic<bool> interrupted_{false};
-};
-
-class VideoFileSource : public FrameSource {
- public:
-  /// Throws FrameSourceError when the file cannot be opened. timestamp_rate_hz > 0 overrides the
-  /// container's timestamps with frame index / rate.
-  explicit VideoFileSource(const std::string& path, double timestamp_rate_hz = 0.0);
-  std::string describe() const override;
-  std::optional<Frame> next() override;
-  void interrupt() override { interrupted_.store(true); }
-  std::int64_t skippedFrames() const override { return skipped_; }
-  std::int64_t frameCountHint() const override { return frame_count_; }
-
- private:
-  std::string path_;
-  cv::VideoCapture capture_;
-  double rate_hz_;
-  double container_fps_ = 0;
-  std::int64_t frame_count_ = -1;
-  std::int64_t next_index_ = 0;
   std::int64_t skipped_ = 0;
   std::atomic<bool> interrupted_{false};
 };
