@@ -123,6 +123,12 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   std::optional<MotionReplay> motion = openMotion(o.motion, o.sources.size(), "map", segmenter_config);
   const fs::path out_dir(o.out);
   createRunFolder(o.out);
+  // The run folder's map.tsm is ours until the end: a second `map` (or a toposlamd) on it is refused
+  // before any work, and temporaries a killed run left there are removed.
+  const std::filesystem::path map_path = std::filesystem::path(o.out) / "map.tsm";
+  const MapLock map_lock = MapLock::acquire(map_path);
+  if (const int orphans = MapStore::removeOrphanedTemporaries(map_path); orphans > 0)
+    std::cerr << "map: removed " << orphans << " temporary files of an interrupted save in " << o.out << "\n";
 
   const MethodPreset preset = presetOf(o.segmentation, "map");
   VpackConfig vpack = preset.fingerprint;
@@ -381,7 +387,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
     }
   }
-  MapStore::save(out_dir / "map.tsm", *filter, encodeOrigins(origins), fingerprintMapSettings(vpack));
+  MapStore::save(map_path, *filter, encodeOrigins(origins), fingerprintMapSettings(vpack));
 
   std::printf(
       "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "
