@@ -19,6 +19,8 @@ done
 [ ! -e "$dest/pkg/usr/etc" ] || fail "install --prefix /usr wrote usr/etc/ (toposlamd never reads it): $(find "$dest/pkg/usr/etc")"
 grep -q "^ExecStart=/usr/sbin/toposlamd\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
   || fail "the unit installed with --prefix /usr does not start /usr/sbin/toposlamd"
+grep -q "^Documentation=file:///usr/share/doc/toposlam/daemon.md\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
+  || fail "the unit installed with --prefix /usr does not name /usr/share/doc/toposlam/daemon.md"
 "$dest/pkg/usr/sbin/toposlamd" --check-config -c "$dest/pkg/etc/toposlam/toposlam.yaml"
 
 # 2. A private prefix: everything under it, the unit pointing at its binary.
