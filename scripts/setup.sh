@@ -10,6 +10,7 @@ BUILD_PACKAGES=(
   build-essential cmake ninja-build pkg-config ccache
   libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
+  help2man file  # the man pages from --help; `file`: cpack's dpkg-shlibdeps step (scripts/package.sh)
 )
 # To run toposlam, toposlamd and the demo.
 RUNTIME_PACKAGES=(
@@ -21,6 +22,7 @@ TEST_PACKAGES=(
   chromium chromium-driver python3  # browser check of `toposlam report` over WebDriver (ctest -L browser)
   qemu-system-x86 busybox-static cpio kmod xz-utils v4l-utils ffmpeg  # VM camera test (tests/vm)
   libcamera-ipa libcamera-tools  # VM test: libcamera's vimc IPA module, `cam --list` (tests/vm)
+  lintian  # the Debian package's check (ctest -L package)
 )
 
 with_tests=0

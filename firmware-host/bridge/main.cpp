@@ -246,6 +246,7 @@ int runEmulator(const EmulateOptions& o) {
 
 int main(int argc, char** argv) {
   CLI::App app{"toposlam-bridge: robot controller link (wheel link or MAVLink 2) -> TOPOSLAM_MOTION over LCM"};
+  app.set_version_flag("--version", "toposlam-bridge " TOPOSLAM_VERSION);  // project(VERSION), the package version
   bridge::BridgeConfig config;
   std::string config_path;
   std::string serial, protocol, lcm_url, channel;

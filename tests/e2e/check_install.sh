@@ -19,6 +19,8 @@ done
 [ ! -e "$dest/pkg/usr/etc" ] || fail "install --prefix /usr wrote usr/etc/ (toposlamd never reads it): $(find "$dest/pkg/usr/etc")"
 grep -q "^ExecStart=/usr/sbin/toposlamd\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
   || fail "the unit installed with --prefix /usr does not start /usr/sbin/toposlamd"
+grep -q "^Documentation=file:///usr/share/doc/toposlam/daemon.md\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
+  || fail "the unit installed with --prefix /usr does not name /usr/share/doc/toposlam/daemon.md"
 "$dest/pkg/usr/sbin/toposlamd" --check-config -c "$dest/pkg/etc/toposlam/toposlam.yaml"
 # The video module (loaded on first use) is installed beside the programs, and the installed program
 # loads that copy, not the build tree's.

@@ -7,12 +7,13 @@ fail() { echo "FAIL: $*"; exit 1; }
 runtime="$(bash "$root/scripts/setup.sh" --print)" || fail "setup.sh --print failed"
 all="$(bash "$root/scripts/setup.sh" --test --print)" || fail "setup.sh --test --print failed"
 has() { printf '%s\n' "$1" | grep -qx "$2"; }
-for p in qemu-system-x86 busybox-static chromium chromium-driver ffmpeg libcamera-tools cpio; do
+for p in qemu-system-x86 busybox-static chromium chromium-driver ffmpeg libcamera-tools cpio lintian; do
   has "$runtime" "$p" && fail "test-only package $p is in the default (build + runtime) set"
   has "$all" "$p" || fail "test-only package $p is missing from --test"
 done
-# What the build and the README's demo need: compilers, libraries, LCM, dot (map drawing), ip (netns).
-for p in build-essential cmake libopencv-dev liblcm-dev liblcm-bin libsystemd-dev catch2 graphviz iproute2; do
+# What the build and the README's demo need: compilers, libraries, LCM, dot (map drawing), ip (netns),
+# help2man (man pages).
+for p in build-essential cmake libopencv-dev liblcm-dev liblcm-bin libsystemd-dev catch2 graphviz iproute2 help2man; do
   has "$runtime" "$p" || fail "$p is missing from the default set"
 done
 for p in $runtime; do has "$all" "$p" || fail "--test drops $p"; done

@@ -13,7 +13,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"toposlam: visual topological SLAM for indoor robots with one forward-facing camera"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "toposlam 0.1.0");
+  app.set_version_flag("--version", "toposlam " TOPOSLAM_VERSION);  // project(VERSION), the package version
   toposlam::cli::addFingerprintCommand(app);
   toposlam::cli::addBenchCommand(app);
   toposlam::cli::addMapCommand(app);

@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
-  app.set_version_flag("--version", "toposlamd 0.1.0");
+  app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
   std::string source, map_path, lcm_url, overflow;
   bool check_only = false, no_load = false, bench = false;
