@@ -23,6 +23,11 @@ MethodPreset methodPreset(const std::string& name) {
     p.topology.relative_slope = 2.0;
     p.topology.relative_offset = 8.0;
     p.topology.relative_sigma_floor = 0.02;
+    // "Stay" 0.33 instead of the thesis' 0.05 (gamma(k = 10, theta = 0.25)): a second visit is cut into
+    // places where the first was not, so consecutive places on one node are common on real frames
+    // (docs/topology.md, "Staying in a node").
+    p.topology.gamma_shape = 5.0;
+    p.topology.gamma_scale = 0.4;
   }
   if (name == "thesis") {
     p.segmentation.window_s = 0.0;  // n = 25 frames (section 4.2), at the thesis' ~5 fps
