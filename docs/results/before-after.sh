@@ -40,12 +40,23 @@ echo "-- localize before (session-start binary) / after default / after thesis p
 $OLD localize --places $S/places.csv --queries $S/queries.csv 2>/dev/null | grep -E "^all|0.50 "
 $NEW localize --places $S/places.csv --queries $S/queries.csv 2>/dev/null | grep -E "^all|0.50 "
 $NEW localize --places $S/places.csv --queries $S/queries.csv --preset thesis 2>/dev/null | grep -E "^all|0.50 "
+echo "-- along the route (--route): samples, then the corridor's localisation set (single images / route)"
+$NEW localize --places $S/places.csv --queries $S/queries.csv --route 2>/dev/null | grep -E "^all|0.50 "
+$NEW localize --places $C/places.csv --queries $C/queries.csv 2>/dev/null | grep -E "^all|0.50 "
+$NEW localize --places $C/places.csv --queries $C/queries.csv --route --no-loop 2>/dev/null | grep -E "^all|0.50 "
+echo "== recognition: corridor, sequences of 10 with 200 keypoints (beside the baseline with the same budget)"
+$NEW recognition --reference images:$C/ref --query images:$C/query --truth $C/gt.csv --sequence 10 --max-keypoints 200 --quiet | grep -E "seq 10"
 echo "== map samples"
 $OLD map images:$S/samples --out before-s 2>&1 | tail -1
 $NEW map images:$S/samples --out after-s 2>&1 | tail -1
 $NEW map images:$S/samples --preset thesis --out thesis-s 2>&1 | tail -1
 $NEW eval after-s --truth $S/samples_GT_pairs.csv --json > after-s.json 2>/dev/null
 $NEW eval before-s --truth $S/samples_GT_pairs.csv --json > before-s.json 2>/dev/null
+echo "-- map samples with a 5 s window (a second lap cut where the first was not)"
+$OLD map images:$S/samples --window-s 5 --out before-s5 >/dev/null 2>&1
+$NEW map images:$S/samples --window-s 5 --out after-s5 >/dev/null 2>&1
+$NEW eval before-s5 --truth $S/samples_GT_pairs.csv --json > before-s5.json 2>/dev/null
+$NEW eval after-s5 --truth $S/samples_GT_pairs.csv --json > after-s5.json 2>/dev/null
 echo "-- frame-level baseline: each frame's best earlier frame at least 25 back (= eval's min gap)"
 $NEW recognition images:$S/samples --truth $S/samples_GT_pairs.csv --min-gap 25 --quiet | grep -E "toposlam \(|ORB baseline"
 echo "== map corridor as one sequence"
@@ -59,7 +70,7 @@ $NEW eval before-o --truth $O/labels.csv --json > before-o.json 2>/dev/null
 $NEW eval after-o --truth $O/labels.csv --json > after-o.json 2>/dev/null
 python3 - <<'PY'
 import json
-for n in ('before-s','after-s','after-c','before-o','after-o'):
+for n in ('before-s','after-s','before-s5','after-s5','after-c','before-o','after-o'):
     try: d=json.load(open('%s.json'%n))
     except Exception as e: print(n,'no eval',e); continue
     out=[n]
