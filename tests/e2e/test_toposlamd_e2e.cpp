@@ -3,11 +3,8 @@
 // is closed), READY/WATCHDOG on a fake NOTIFY_SOCKET, and that SIGTERM mid-run saves a map that resumes.
 #include <catch2/catch.hpp>
 
-#include <signal.h>
 #include <sys/socket.h>
 #include <sys/un.h>
-#include <sys/wait.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "e2e_harness.hpp"
 #include "toposlam/io/sim_source.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
@@ -32,6 +30,11 @@
 
 namespace fs = std::filesystem;
 using namespace toposlam;
+using e2e::freshDirectory;
+using e2e::Heard;
+using e2e::integerField;
+using e2e::listenUntilExit;
+using e2e::numberField;
 
 namespace {
 
@@ -64,109 +67,31 @@ class FakeNotifySocket {
   int fd_ = -1;
 };
 
-/// toposlamd as a child process.
-class Daemon {
+/// toposlamd as a child process, its output in `log`; with `notify_socket`, started as systemd would (a 1 s
+/// watchdog).
+class Daemon : public e2e::ChildProcess {
  public:
-  Daemon(const std::vector<std::string>& args, const std::string& notify_socket, const fs::path& log) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      if (!notify_socket.empty()) {
-        setenv("NOTIFY_SOCKET", notify_socket.c_str(), 1);
-        setenv("WATCHDOG_USEC", "1000000", 1);
-        setenv("WATCHDOG_PID", std::to_string(getpid()).c_str(), 1);
-      }
-      std::vector<char*> argv;
-      const std::string binary = TOPOSLAMD_BINARY;
-      argv.push_back(const_cast<char*>(binary.c_str()));
-      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      execv(binary.c_str(), argv.data());
-      _exit(127);
-    }
-  }
-  ~Daemon() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  void terminate() { kill(pid_, SIGTERM); }
-  /// Exit status once the process ended, else -1 (non-blocking).
-  int poll() {
-    if (exited_) return status_;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == pid_) {
-      exited_ = true;
-      status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-    return exited_ ? status_ : -1;
-  }
+  Daemon(const std::vector<std::string>& args, const std::string& notify_socket, const fs::path& log)
+      : ChildProcess(TOPOSLAMD_BINARY, args, options(notify_socket, log)) {}
 
  private:
-  pid_t pid_ = -1;
-  bool exited_ = false;
-  int status_ = -1;
-};
-
-struct Heard {
-  std::vector<ReceivedMessage> places, events, statuses, topologies;
-};
-
-/// Listens until the daemon exits (or `deadline_s`), calling `each` after every batch; returns the exit code.
-template <typename Each>
-int listenUntilExit(LcmSubscriber& subscriber, Daemon& daemon, double deadline_s, Each each) {
-  const auto start = std::chrono::steady_clock::now();
-  int code = -1;
-  while ((code = daemon.poll()) < 0) {
-    subscriber.handle(50);
-    each();
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > deadline_s) return -2;
+  static Options options(const std::string& notify_socket, const fs::path& log) {
+    Options o;
+    o.log_file = log;
+    if (!notify_socket.empty()) {
+      o.environment = {{"NOTIFY_SOCKET", notify_socket}, {"WATCHDOG_USEC", "1000000"}};
+      o.pid_variable = "WATCHDOG_PID";
+    }
+    return o;
   }
-  for (int i = 0; i < 5; ++i) subscriber.handle(20);  // late datagrams
-  return code;
-}
+};
 
-fs::path freshDirectory(const std::string& name) {
-  fs::path dir = fs::path(TOPOSLAM_BINARY_DIR) / "e2e" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::unique_ptr<LcmSubscriber> subscribe(Heard& heard) {
-  const LcmChannels channels;
-  return std::make_unique<LcmSubscriber>(
-      kLcmUrl, channels,
-      std::vector<std::string>{channels.place, channels.place_event, channels.status, channels.topology},
-      [&heard](const ReceivedMessage& m) {
-        if (m.kind == "place") heard.places.push_back(m);
-        if (m.kind == "place_event") heard.events.push_back(m);
-        if (m.kind == "status") heard.statuses.push_back(m);
-        if (m.kind == "topology") heard.topologies.push_back(m);
-      });
-}
+std::unique_ptr<LcmSubscriber> subscribe(Heard& heard) { return e2e::subscribe(kLcmUrl, heard); }
 
 bool contains(const std::vector<std::string>& lines, const std::string& text) {
   for (const std::string& l : lines)
     if (l.find(text) != std::string::npos) return true;
   return false;
-}
-
-/// An integer field of a message's JSON, -1 when absent.
-std::int64_t integerField(const ReceivedMessage& m, const std::string& name) {
-  const std::string key = "\"" + name + "\":";
-  const std::size_t at = m.json.find(key);
-  return at == std::string::npos ? -1 : std::stoll(m.json.substr(at + key.size()));
-}
-
-/// A number field of a message's JSON, NaN when absent.
-double numberField(const ReceivedMessage& m, const std::string& name) {
-  const std::string key = "\"" + name + "\":";
-  const std::size_t at = m.json.find(key);
-  return at == std::string::npos ? std::nan("") : std::stod(m.json.substr(at + key.size()));
 }
 
 /// Representative frame of a place event, from its JSON.
@@ -436,13 +361,16 @@ SCENARIO("Robot motion over LCM: the status says it is used while it arrives, an
                   "", dir / "toposlamd.log");
     // Motion starts after the first status (the daemon's LCM is up), every 50 ms, for 4 s.
     const auto started = std::chrono::steady_clock::now();
-    std::optional<std::chrono::steady_clock::time_point> motion_from;
+    std::optional<std::chrono::steady_clock::time_point> motion_from, next_sample;
     std::int64_t sequence = 0, first_sample_us = -1, last_sample_us = -1;
     bool sent_stop = false;
     const int code = listenUntilExit(*subscriber, daemon, 60.0, [&] {
       const auto now = std::chrono::steady_clock::now();
-      if (!motion_from && !heard.statuses.empty()) motion_from = now;
-      if (motion_from && now - *motion_from < std::chrono::seconds(4)) {
+      if (!motion_from && !heard.statuses.empty()) motion_from = next_sample = now;
+      // On a 50 ms schedule, not once per loop: the subscriber hears these messages too, and each one
+      // heard ends a wait early.
+      if (motion_from && now - *motion_from < std::chrono::seconds(4) && now >= *next_sample) {
+        *next_sample += std::chrono::milliseconds(50);
         toposlam_lcm::motion_t m{};
         m.utime = monotonicMicroseconds();
         if (first_sample_us < 0) first_sample_us = m.utime;
@@ -462,43 +390,27 @@ SCENARIO("Robot motion over LCM: the status says it is used while it arrives, an
     THEN("a status first says none, then used with standing frames skipped, then lost; the daemon exits 0") {
       CHECK(code == 0);
       REQUIRE(sequence > 40);
-      int first_used = -1, first_lost = -1;
-      std::int64_t standing = 0;
-      for (std::size_t i = 0; i < heard.statuses.size(); ++i) {
-        const std::string& json = heard.statuses[i].json;
-        INFO(json);
-        if (first_used < 0 && json.find("\"motion_state\":\"used\"") != std::string::npos) first_used = static_cast<int>(i);
-        if (first_lost < 0 && json.find("\"motion_state\":\"lost\"") != std::string::npos) first_lost = static_cast<int>(i);
-        const std::string key = "\"motion_standing_frames\":";
-        if (const std::size_t at = json.find(key); at != std::string::npos)
-          standing = std::max<std::int64_t>(standing, std::stoll(json.substr(at + key.size())));
-      }
       REQUIRE_FALSE(heard.statuses.empty());
-      CHECK_THAT(heard.statuses.front().json, Catch::Contains("\"motion_state\":\"none\""));
-      CHECK(first_used >= 0);
-      CHECK(first_lost > first_used);
+      const e2e::MotionStatusHistory status = e2e::motionStatusHistory(heard.statuses);
+      INFO("first status " << heard.statuses.front().json);
+      INFO("last status " << heard.statuses.back().json);
+      CHECK(status.first_says_none);
+      CHECK(status.first_used >= 0);
+      CHECK(status.first_lost > status.first_used);
       // Standing from 1 s after the first sample (standing_after_s) until the link is declared lost 1 s after
       // the last one (timeout_s): 4 s, 100 frames at 25 fps (measured: 100). A loaded machine (sanitizers)
       // captures fewer or bunched frames, so the expectation is the frames captured in that interval, from
       // the place messages' capture times.
-      std::int64_t expected = 0;
-      for (const ReceivedMessage& p : heard.places) {
-        // When the frame left the source (the clock motion is looked up at): published minus latency.
-        const double t = numberField(p, "publish_utime") - 1000.0 * numberField(p, "latency_ms");
-        expected += t >= static_cast<double>(first_sample_us + 1'000'000) &&
-                            t < static_cast<double>(last_sample_us + 1'000'000)
-                        ? 1
-                        : 0;
-      }
+      const std::int64_t expected =
+          e2e::framesCapturedIn(heard.places, static_cast<double>(first_sample_us + 1'000'000),
+                                static_cast<double>(last_sample_us + 1'000'000));
+      const std::int64_t standing = status.standing_frames;
       INFO("standing frames " << standing << ", frames captured while standing " << expected);
       CHECK(standing >= 25);
       CHECK(std::abs(standing - expected) <= std::max<std::int64_t>(5, expected / 10));
       // Every message sent was heard (UDP on loopback may lose one under load).
-      const std::string& last = heard.statuses.back().json;
-      const std::string key = "\"motion_messages\":";
-      const std::size_t at = last.find(key);
-      REQUIRE(at != std::string::npos);
-      const std::int64_t received = std::stoll(last.substr(at + key.size()));
+      const std::int64_t received = status.messages;
+      REQUIRE(received >= 0);
       CHECK(received <= sequence);
       CHECK(received >= sequence - sequence / 20);
     }

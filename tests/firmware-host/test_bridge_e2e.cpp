@@ -6,12 +6,8 @@
 #include <catch2/catch.hpp>
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netinet/in.h>
-#include <poll.h>
-#include <signal.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -22,6 +18,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "e2e/e2e_harness.hpp"
 #include "toposlam/firmware/emulator.hpp"
 #include "toposlam/firmware/serial_port.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
@@ -50,84 +47,18 @@ struct Heard {
   }
 };
 
-/// LCM that can hear itself, or exit 77.
+/// LCM that can hear itself (else the test exits 77), subscribed to kChannel.
 std::unique_ptr<lcm::LCM> lcmOrSkip(Heard& heard) {
-  std::unique_ptr<lcm::LCM> l;
-  try {
-    l = toposlam::openLcm(kLcmUrl);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "skipped: %s\n", e.what());
-    std::_Exit(77);
-  }
+  toposlam::e2e::skipUnlessMulticastLoopsBack(kLcmUrl);
+  auto l = toposlam::openLcm(kLcmUrl);
   l->subscribeFunction(kChannel, &Heard::onMessage, &heard);
-  toposlam_lcm::motion_t probe{};
-  probe.sequence = -1;
-  l->publish(kChannel, &probe);
-  if (l->handleTimeout(1000) <= 0 || heard.messages.empty()) {
-    std::fprintf(stderr, "skipped: LCM multicast does not loop back here\n");
-    std::_Exit(77);
-  }
-  heard.messages.clear();
   return l;
 }
 
-/// toposlam-bridge as a child; its stderr is a pipe we read.
-class Bridge {
+/// toposlam-bridge as a child; its output is a pipe the test reads.
+class Bridge : public toposlam::e2e::ChildProcess {
  public:
-  explicit Bridge(const std::vector<std::string>& args) {
-    int fds[2];
-    REQUIRE(pipe(fds) == 0);
-    pid_ = fork();
-    if (pid_ == 0) {
-      dup2(fds[1], 2);
-      close(fds[0]);
-      std::vector<char*> argv;
-      const std::string binary = TOPOSLAM_BRIDGE_BINARY;
-      argv.push_back(const_cast<char*>(binary.c_str()));
-      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      execv(binary.c_str(), argv.data());
-      _exit(127);
-    }
-    close(fds[1]);
-    err_ = fds[0];
-  }
-  ~Bridge() {
-    if (pid_ > 0) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-    close(err_);
-  }
-  /// Reads stderr until `text` appears or timeout_ms passes.
-  bool waitFor(const std::string& text, int timeout_ms) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
-    while (log_.find(text) == std::string::npos) {
-      const int left = static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count());
-      if (left <= 0) return false;
-      pollfd p{err_, POLLIN, 0};
-      if (poll(&p, 1, left) <= 0) continue;
-      char buffer[4096];
-      const ssize_t n = read(err_, buffer, sizeof buffer);
-      if (n <= 0) return log_.find(text) != std::string::npos;
-      log_.append(buffer, static_cast<std::size_t>(n));
-    }
-    return true;
-  }
-  int stop() {
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    waitFor("\n\n", 200);  // collect the rest of the log
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-  const std::string& log() const { return log_; }
-
- private:
-  pid_t pid_ = -1;
-  int err_ = -1;
-  std::string log_;
+  explicit Bridge(const std::vector<std::string>& args) : ChildProcess(TOPOSLAM_BRIDGE_BINARY, args) {}
 };
 
 /// Handles LCM messages for `ms` milliseconds (the test must keep up: LCM drops what it cannot buffer).
@@ -151,7 +82,7 @@ TEST_CASE("GIVEN the emulated wheel controller on a pty WHEN toposlam-bridge run
   PseudoTerminal pty = openPseudoTerminal();
   Bridge bridge({"--serial", pty.slave_path, "--baud", "115200", "--protocol", "wheel", "--lcm-url", kLcmUrl,
                  "--channel", kChannel, "--status-period", "0"});
-  REQUIRE(bridge.waitFor("-> LCM", 5000));
+  REQUIRE(bridge.waitForOutput("-> LCM", 5000));
 
   EmulatorConfig c;
   c.profile = *parseProfile("2@0.5,2@0,2@0.1667@0.3,1@0");
@@ -171,7 +102,7 @@ TEST_CASE("GIVEN the emulated wheel controller on a pty WHEN toposlam-bridge run
   const std::size_t expected = emulator.truth().motion_frames_intact - 1;
   collect(*l, heard, expected, 5000);
   CHECK(bridge.stop() == 0);
-  INFO(bridge.log());
+  INFO(bridge.output());
   CHECK(heard.undecodable == 0);
   REQUIRE(heard.messages.size() == expected);
   double forward = 0, turn = 0;
@@ -186,8 +117,8 @@ TEST_CASE("GIVEN the emulated wheel controller on a pty WHEN toposlam-bridge run
   CHECK(turn == Approx(emulator.truth().turn_rad).margin(1e-3));
   CHECK(standing > 120);  // 3 s of 7 standing at 50 Hz, less drops and damage
   CHECK(standing < 152);
-  CHECK(bridge.log().find("bridge exit") != std::string::npos);
-  CHECK(bridge.log().find("bad crc") != std::string::npos);
+  CHECK(bridge.output().find("bridge exit") != std::string::npos);
+  CHECK(bridge.output().find("bad crc") != std::string::npos);
 }
 
 TEST_CASE("GIVEN MAVLink 2 ODOMETRY from a router on UDP localhost WHEN toposlam-bridge listens THEN motion_t arrives",
@@ -197,7 +128,7 @@ TEST_CASE("GIVEN MAVLink 2 ODOMETRY from a router on UDP localhost WHEN toposlam
   const int port = 14550 + static_cast<int>(getpid() % 1000);
   Bridge bridge({"--udp", std::to_string(port), "--protocol", "mavlink", "--lcm-url", kLcmUrl, "--channel", kChannel,
                  "--status-period", "0"});
-  REQUIRE(bridge.waitFor("-> LCM", 5000));
+  REQUIRE(bridge.waitForOutput("-> LCM", 5000));
   EmulatorConfig c;
   c.messages = EmulatedMessages::MavlinkOdometry;
   c.profile = *parseProfile("2@1.0,1@0");
@@ -221,21 +152,21 @@ TEST_CASE("GIVEN MAVLink 2 ODOMETRY from a router on UDP localhost WHEN toposlam
   const std::size_t expected = emulator.truth().motion_frames_intact - 1;
   collect(*l, heard, expected, 5000);
   CHECK(bridge.stop() == 0);
-  INFO(bridge.log());
+  INFO(bridge.output());
   CHECK(heard.undecodable == 0);
   REQUIRE(heard.messages.size() == expected);
   double forward = 0;
   for (const auto& m : heard.messages) forward += m.forward_m;
   CHECK(forward == Approx(emulator.truth().distance_m).margin(0.04));
   // One MAVLink 1 and one signed frame per heartbeat (1 Hz): skipped and counted, never published.
-  CHECK(bridge.log().find("signed skipped 0,") == std::string::npos);
-  CHECK(bridge.log().find("mavlink1 skipped 0,") == std::string::npos);
-  CHECK(bridge.log().find("signed skipped") != std::string::npos);
+  CHECK(bridge.output().find("signed skipped 0,") == std::string::npos);
+  CHECK(bridge.output().find("mavlink1 skipped 0,") == std::string::npos);
+  CHECK(bridge.output().find("signed skipped") != std::string::npos);
 }
 
 TEST_CASE("GIVEN no such device WHEN toposlam-bridge starts THEN it exits 3 with an actionable message",
           "[firmware][bridge]") {
   Bridge bridge({"--serial", "/dev/toposlam-no-such-tty", "--protocol", "wheel"});
-  CHECK(bridge.waitFor("plugged in", 5000));
+  CHECK(bridge.waitForOutput("plugged in", 5000));
   CHECK(bridge.stop() == 3);
 }
