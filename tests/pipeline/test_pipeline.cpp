@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <future>
+#include <thread>
 #include <set>
 
 #include "pipeline_fakes.hpp"
@@ -434,13 +435,25 @@ SCENARIO("GIVEN a slow disk WHEN the map is saved periodically THEN frames keep 
   std::promise<void> disk_free;
   std::shared_future<void> free = disk_free.get_future().share();
   std::atomic<int> writes_started{0};
+  std::atomic<bool> topology_running{false};
   topology.on_write = [&] {
     if (writes_started.fetch_add(1) == 0) free.wait();  // the first (periodic) write hangs on the disk
   };
   source.before_frame = [&, once = false](std::int64_t i) mutable {
     if (i == 20 && !once) {
       once = true;
+      // The topology thread counts the save period from its own start: advance the clock only once it runs
+      // (a frame published has gone through it), or a late start (a loaded machine) would never be due.
+      topology_running = sink.waitForFramesFor(1, std::chrono::seconds(10));  // checked below (Catch2: one thread)
       clock.advance(2.0);  // past the 1 s save period: the topology thread snapshots at its next record
+    }
+    if (i == 60) {
+      // Let the map writer reach the disk before the rest flows: on a loaded machine the frames after this
+      // one could otherwise all be published before the writer thread ran at all (seen in CI). (Not at
+      // frame 21: the snapshot waits for frame 20's record, which the segmentation holds for a few frames.)
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (writes_started.load() == 0 && std::chrono::steady_clock::now() < give_up)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   };
   PipelineConfig config = losslessConfig();
@@ -452,6 +465,7 @@ SCENARIO("GIVEN a slow disk WHEN the map is saved periodically THEN frames keep 
   disk_free.set_value();
   pipeline.wait();
   THEN("all 200 frames were published while the periodic write was still blocked; then the final save followed") {
+    CHECK(topology_running);
     CHECK(all_published);
     CHECK(writes_while_blocked == 1);
     REQUIRE(topology.saves.size() == 2);
