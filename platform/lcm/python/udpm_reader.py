@@ -34,7 +34,7 @@ MAGIC_SHORT = 0x4C433032  # "LC02"
 MAGIC_FRAGMENT = 0x4C433033  # "LC03"
 _SHORT_HEADER = struct.Struct(">II")  # magic, sequence number
 _FRAGMENT_HEADER = struct.Struct(">IIIIHH")  # magic, sequence, payload size, offset, fragment, fragments
-MAX_CHANNEL_BYTES = 255  # LCM_MAX_CHANNEL_NAME_LENGTH (63 in older LCM; 255 accepted here)
+MAX_CHANNEL_BYTES = 255  # LCM 1.3 allows 63 (LCM_MAX_CHANNEL_NAME_LENGTH); longer names are accepted here
 
 
 def parse_url(url):
