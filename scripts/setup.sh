@@ -19,7 +19,8 @@ RUNTIME_PACKAGES=(
 )
 # Only for tests.
 TEST_PACKAGES=(
-  chromium chromium-driver python3  # browser check of `toposlam report` over WebDriver (ctest -L browser)
+  chromium chromium-driver  # browser check of `toposlam report` over WebDriver (ctest -L browser)
+  python3  # that browser check; the Python LCM reader and examples (test_platform_udpm_reader, e2e_examples_*)
   qemu-system-x86 busybox-static cpio kmod xz-utils v4l-utils ffmpeg  # VM camera test (tests/vm)
   libcamera-ipa libcamera-tools  # VM test: libcamera's vimc IPA module, `cam --list` (tests/vm)
   lintian  # the Debian package's check (ctest -L package)

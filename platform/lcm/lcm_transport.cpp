@@ -123,8 +123,8 @@ void LcmPipelineSink::publish(const FrameResult& r) {
     msg.edges.reserve(t.edges.size());
     for (const TopologyEdge& edge : t.edges) {
       toposlam_lcm::topology_edge_t m{};
-      m.from = edge.from;
-      m.to = edge.to;
+      m.from_node = edge.from;
+      m.to_node = edge.to;
       m.count = edge.count;
       msg.edges.push_back(m);
     }
@@ -423,7 +423,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
         w.endArray().endObject();
       }
       w.endArray().key("edges").beginArray();
-      for (const auto& e : m.edges) w.beginObject().field("from", e.from).field("to", e.to).field("count", e.count).endObject();
+      for (const auto& e : m.edges) w.beginObject().field("from", e.from_node).field("to", e.to_node).field("count", e.count).endObject();
       w.endArray();
       char line[160];
       std::snprintf(line, sizeof line, "TOPOLOGY  rev %lld  %d nodes  %d edges  p=%.2f  current node %d",

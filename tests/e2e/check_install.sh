@@ -13,9 +13,12 @@ fail() { echo "$*"; exit 1; }
 DESTDIR="$dest/pkg" cmake --install "$build" --prefix /usr >/dev/null
 for f in usr/sbin/toposlamd usr/bin/toposlam usr/lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
          usr/share/toposlam/lcm/place_t.lcm usr/share/toposlam/lcm/motion_t.lcm usr/include/toposlam_lcm/place_t.hpp \
-         usr/share/doc/toposlam/examples/50-toposlam-multicast.network etc/toposlam/toposlam-bridge.yaml; do
+         usr/share/doc/toposlam/examples/50-toposlam-multicast.network etc/toposlam/toposlam-bridge.yaml \
+         usr/lib/python3/dist-packages/toposlam_lcm/__init__.py usr/lib/python3/dist-packages/toposlam_lcm/udpm_reader.py \
+         usr/share/doc/toposlam/examples/python/listen_places.py usr/share/doc/toposlam/examples/cpp/listen_places.cpp; do
   [ -e "$dest/pkg/$f" ] || fail "missing after install --prefix /usr: $f"
 done
+[ -z "$(find "$dest/pkg" -name __pycache__ -o -name '*.pyc')" ] || fail "install --prefix /usr wrote Python byte code"
 [ ! -e "$dest/pkg/usr/etc" ] || fail "install --prefix /usr wrote usr/etc/ (toposlamd never reads it): $(find "$dest/pkg/usr/etc")"
 grep -q "^ExecStart=/usr/sbin/toposlamd\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
   || fail "the unit installed with --prefix /usr does not start /usr/sbin/toposlamd"
@@ -35,7 +38,8 @@ fi
 
 # 2. A private prefix: everything under it, the unit pointing at its binary.
 cmake --install "$build" --prefix "$dest/local" >/dev/null
-for f in sbin/toposlamd bin/toposlam lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml; do
+for f in sbin/toposlamd bin/toposlam lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
+         lib/python3/dist-packages/toposlam_lcm/place_t.py; do
   [ -e "$dest/local/$f" ] || fail "missing after install --prefix P: P/$f"
 done
 grep -q "^ExecStart=$dest/local/sbin/toposlamd\$" "$dest/local/lib/systemd/system/toposlamd.service" \

@@ -29,7 +29,10 @@ for f in /usr/bin/toposlam /usr/sbin/toposlamd /usr/bin/toposlam-bridge /usr/lib
          /etc/toposlam/toposlam.yaml /etc/toposlam/toposlam-bridge.yaml /usr/share/toposlam/lcm/place_t.lcm \
          /usr/include/toposlam_lcm/place_t.hpp /usr/share/pkgconfig/toposlam-lcm.pc /usr/share/doc/toposlam/copyright \
          /usr/share/doc/toposlam/changelog.gz /usr/share/man/man1/toposlam.1.gz /usr/share/man/man8/toposlamd.8.gz \
-         /usr/share/man/man1/toposlam-bridge.1.gz; do
+         /usr/share/man/man1/toposlam-bridge.1.gz /usr/lib/python3/dist-packages/toposlam_lcm/__init__.py \
+         /usr/lib/python3/dist-packages/toposlam_lcm/place_t.py /usr/lib/python3/dist-packages/toposlam_lcm/topology_edge_t.py \
+         /usr/lib/python3/dist-packages/toposlam_lcm/udpm_reader.py /usr/share/doc/toposlam/examples/python/listen_places.py \
+         /usr/share/doc/toposlam/examples/cpp/listen_places.cpp; do
   grep -qx "$f" "$tmp/files" || fail "the package has no $f (man pages need help2man: scripts/setup.sh)"
 done
 if grep -E '^/usr/local/|^/usr/etc/' "$tmp/files"; then fail "files outside the FHS paths of a package"; fi
@@ -68,4 +71,14 @@ cflags="$(PKG_CONFIG_PATH="$tmp/root/usr/share/pkgconfig" pkg-config --cflags to
 # shellcheck disable=SC2086  # $cflags is a list of flags
 echo '#include <toposlam_lcm/place_event_t.hpp>' | c++ -std=c++17 -fsyntax-only $cflags -x c++ - \
   || fail "toposlam_lcm/place_event_t.hpp does not compile with pkg-config --cflags toposlam-lcm ($cflags)"
+# The Python package imports with Debian's python3 (types and reader; no python3-lcm), and the C++ example
+# compiles with the packaged headers.
+if [ -x /usr/bin/python3 ]; then
+  PYTHONPATH="$tmp/root/usr/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -c \
+    'import toposlam_lcm, toposlam_lcm.udpm_reader as r; e = toposlam_lcm.topology_edge_t(); e.from_node = 1; r.parse_url(r.DEFAULT_URL)' \
+    || fail "the packaged Python package toposlam_lcm does not import"
+fi
+# shellcheck disable=SC2086  # $cflags is a list of flags
+c++ -std=c++17 -fsyntax-only $cflags "$tmp/root/usr/share/doc/toposlam/examples/cpp/listen_places.cpp" \
+  || fail "the packaged examples/cpp/listen_places.cpp does not compile with pkg-config --cflags toposlam-lcm"
 echo "package OK"
