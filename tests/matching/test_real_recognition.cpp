@@ -107,6 +107,22 @@ eval::RecognitionScore scoreBaseline(const Frames& queries, const Frames& refere
   }, sequence_length);
 }
 
+// The corridor set (Milford 2013, via VPR-Bench): 111 query frames against 111 reference frames.
+struct CorridorSet {
+  Frames references;
+  Frames queries;
+  eval::RecognitionTruth truth;
+};
+
+CorridorSet readCorridor() {
+  const std::string dir = TOPOSLAM_CORRIDOR_DIR;
+  CorridorSet set{readFolder(dir + "/ref"), readFolder(dir + "/query"), {}};
+  REQUIRE(set.references.paths.size() == 111);
+  REQUIRE(set.queries.paths.size() == 111);
+  set.truth = eval::crossTruth(111, 111, samePairs(dir + "/gt.csv", set.queries, set.references, false));
+  return set;
+}
+
 std::string figures(const eval::RecognitionScore& s) {
   return "AUC " + std::to_string(s.auc) + ", top-1 " + std::to_string(s.top1) + ", recall@100%P " +
          std::to_string(s.recall_at_full_precision);
@@ -141,15 +157,9 @@ SCENARIO("GIVEN the bundled corridor loop WHEN the thesis preset is used THEN it
 }
 
 SCENARIO("GIVEN the fisheye corridor set WHEN queries are recognised among the references THEN the default beats the ORB baseline", "[real]") {
-  const std::string dir = TOPOSLAM_CORRIDOR_DIR;
-  const Frames references = readFolder(dir + "/ref");
-  const Frames queries = readFolder(dir + "/query");
-  REQUIRE(references.paths.size() == 111);
-  REQUIRE(queries.paths.size() == 111);
-  const eval::RecognitionTruth truth =
-      eval::crossTruth(111, 111, samePairs(dir + "/gt.csv", queries, references, false));
-  const eval::RecognitionScore ours = scoreOurs("default", queries, references, truth);
-  const eval::RecognitionScore baseline = scoreBaseline(queries, references, truth);
+  const CorridorSet c = readCorridor();
+  const eval::RecognitionScore ours = scoreOurs("default", c.queries, c.references, c.truth);
+  const eval::RecognitionScore baseline = scoreBaseline(c.queries, c.references, c.truth);
   INFO("default: " << figures(ours) << "; ORB baseline: " << figures(baseline));
   // Measured: 0.854 / 0.514 / 0.027; baseline 0.646 / 0.297 / 0.000.
   CHECK(ours.auc >= 0.82);
@@ -254,14 +264,10 @@ SCENARIO("GIVEN the corridor's reference lap as places WHEN the query lap is loc
 
 SCENARIO("GIVEN the fisheye corridor set WHEN queries are recognised as sequences of 10 frames THEN most find their "
          "place, far ahead of the ORB baseline scored the same way", "[real][sequence]") {
-  const std::string dir = TOPOSLAM_CORRIDOR_DIR;
-  const Frames references = readFolder(dir + "/ref");
-  const Frames queries = readFolder(dir + "/query");
-  const eval::RecognitionTruth truth =
-      eval::crossTruth(111, 111, samePairs(dir + "/gt.csv", queries, references, false));
-  const eval::RecognitionScore single = scoreOurs("default", queries, references, truth, 1);
-  const eval::RecognitionScore ours = scoreOurs("default", queries, references, truth, 10);
-  const eval::RecognitionScore baseline = scoreBaseline(queries, references, truth, 10);
+  const CorridorSet c = readCorridor();
+  const eval::RecognitionScore single = scoreOurs("default", c.queries, c.references, c.truth, 1);
+  const eval::RecognitionScore ours = scoreOurs("default", c.queries, c.references, c.truth, 10);
+  const eval::RecognitionScore baseline = scoreBaseline(c.queries, c.references, c.truth, 10);
   INFO("default, sequences of 10: " << figures(ours) << "; single frames: " << figures(single)
                                     << "; ORB baseline, sequences of 10: " << figures(baseline));
   // Measured: 0.963 / 0.847 (94 of 111) / 0.162; single frames 0.854 / 0.514; baseline 0.787 / 0.532 / 0.054.
@@ -286,13 +292,9 @@ SCENARIO("GIVEN the bundled corridor loop WHEN frames are recognised as sequence
 
 SCENARIO("GIVEN the fisheye corridor set WHEN frames keep 200 keypoints and queries are scored as sequences of 10 THEN "
          "top-1 reaches 0.9, far ahead of the ORB baseline with the same budget", "[real][sequence]") {
-  const std::string dir = TOPOSLAM_CORRIDOR_DIR;
-  const Frames references = readFolder(dir + "/ref");
-  const Frames queries = readFolder(dir + "/query");
-  const eval::RecognitionTruth truth =
-      eval::crossTruth(111, 111, samePairs(dir + "/gt.csv", queries, references, false));
-  const eval::RecognitionScore ours = scoreOurs("default", queries, references, truth, 10, 200);
-  const eval::RecognitionScore baseline = scoreBaseline(queries, references, truth, 10, 200);
+  const CorridorSet c = readCorridor();
+  const eval::RecognitionScore ours = scoreOurs("default", c.queries, c.references, c.truth, 10, 200);
+  const eval::RecognitionScore baseline = scoreBaseline(c.queries, c.references, c.truth, 10, 200);
   INFO("default, 200 keypoints, sequences of 10: " << figures(ours) << "; ORB baseline, the same: " << figures(baseline));
   // Measured: 0.964 / 0.919 (102 of 111) / 0.243; baseline 0.862 / 0.532 / 0.108 (`toposlam recognition
   // --reference images:C/ref --query images:C/query --truth C/gt.csv --sequence 10 --max-keypoints 200`).
