@@ -80,10 +80,7 @@ eval::RecognitionScore scoreOurs(const std::string& preset_name, const Frames& q
                                  const eval::RecognitionTruth& truth, int sequence_length = 1, int max_keypoints = -1) {
   const SimilarityPreset preset = similarityPreset(preset_name);
   VpackConfig vpack = preset.fingerprint;
-  if (max_keypoints > 0) {  // as `toposlam recognition --max-keypoints`
-    vpack.keypoints.max_keypoints = max_keypoints;
-    vpack.keypoints.candidate_limit = std::max(vpack.keypoints.candidate_limit, max_keypoints);
-  }
+  if (max_keypoints > 0) vpack.keypoints.setMaxKeypoints(max_keypoints);  // as `recognition --max-keypoints`
   const VpackExtractor extractor(vpack);
   const NgramSimilarity similarity(preset.similarity);
   std::vector<Fingerprint> q, r;

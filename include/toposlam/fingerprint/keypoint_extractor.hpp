@@ -26,6 +26,12 @@ struct KeypointConfig {
   int orb_levels = 4;               ///< ORB pyramid levels (fewer is faster)
   int orb_fast_threshold = 12;      ///< ORB FAST floor; low so the subregions have candidates to choose from
   std::string validate() const;
+  /// Sets the per-frame budget and raises candidate_limit to it where lower (validate() wants
+  /// candidate_limit >= max_keypoints): what every "--max-keypoints N" override means.
+  void setMaxKeypoints(int budget) {
+    max_keypoints = budget;
+    if (candidate_limit < budget) candidate_limit = budget;
+  }
 };
 
 /// Candidates found once per frame, before the per-subregion selection.

@@ -48,10 +48,7 @@ void runMatchingBench(const MatchingBenchOptions& o) {
     const SimilarityPreset preset = similarityPreset(preset_name);
     VpackConfig config = preset.fingerprint;
     config.keypoints.backend = parseKeypointBackend(backend);
-    if (budget > 0) {
-      config.keypoints.max_keypoints = budget;
-      config.keypoints.candidate_limit = std::max(config.keypoints.candidate_limit, budget);
-    }
+    if (budget > 0) config.keypoints.setMaxKeypoints(budget);
     const VpackExtractor extractor(config);
     std::vector<Fingerprint> prints;
     double keypoints = 0, letters = 0;

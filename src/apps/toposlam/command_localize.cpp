@@ -53,7 +53,7 @@ struct Prediction {
   std::string predicted;  ///< label of the most probable place
   double probability = 0.0;
   bool correct = false;
-  std::vector<double> probabilities;  ///< every place's, in place order (JSON only)
+  std::vector<double> probabilities;  ///< every place's (filtered along the route with --route), in place order
 };
 
 struct ThresholdRow {
@@ -249,26 +249,23 @@ void addLocalizeCommand(CLI::App& app) {
   cmd->add_flag("--json", options->json, "Print JSON instead of the table");
   cmd->add_option("--preset", options->preset, "Method preset: default (measured on real frames) or thesis")
       ->capture_default_str();
-  cmd->add_flag("--route", options->route,
+  CLI::Option* route = cmd->add_flag("--route", options->route,
                 "Queries are one traversal in file order through the places in route order (file order): "
                 "filter each query's place probabilities along the route");
   cmd->add_option("--stay", options->route_filter.stay_probability,
                   "With --route: probability of staying in the place between two queries (the rest: the next place)")
       ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(route);
   cmd->add_option("--jump", options->route_filter.jump_weight,
                   "With --route: weight of moving to any place off the route (relocalisation)")
       ->check(CLI::Range(0.0, 1000.0))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(route);
   cmd->add_flag("!--no-loop", options->route_filter.loop,
-                "With --route: the route is not a loop (the last place is not followed by the first)");
-  cmd->callback([options] {
-    if (!options->route && (options->route_filter.stay_probability != PlaceRouteFilterConfig{}.stay_probability ||
-                            options->route_filter.jump_weight != PlaceRouteFilterConfig{}.jump_weight ||
-                            !options->route_filter.loop))
-      throw std::invalid_argument("localize: --stay, --jump and --no-loop need --route");
-    runLocalize(*options);
-  });
+                "With --route: the route is not a loop (the last place is not followed by the first)")
+      ->needs(route);
+  cmd->callback([options] { runLocalize(*options); });
 }
 
 }  // namespace toposlam::cli

@@ -125,7 +125,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   createRunFolder(o.out);
   // The run folder's map.tsm is ours until the end: a second `map` (or a toposlamd) on it is refused
   // before any work, and temporaries a killed run left there are removed.
-  const std::filesystem::path map_path = std::filesystem::path(o.out) / "map.tsm";
+  const fs::path map_path = out_dir / "map.tsm";
   const MapLock map_lock = MapLock::acquire(map_path);
   if (const int orphans = MapStore::removeOrphanedTemporaries(map_path); orphans > 0)
     std::cerr << "map: removed " << orphans << " temporary files of an interrupted save in " << o.out << "\n";

@@ -251,10 +251,8 @@ void runRecognition(const RecognitionOptions& o) {
   const SimilarityPreset preset = similarityPreset(o.preset);
   VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
-  if (o.max_keypoints >= 0) vpack.keypoints.max_keypoints = o.max_keypoints;
+  if (o.max_keypoints >= 0) vpack.keypoints.setMaxKeypoints(o.max_keypoints);
   if (o.orb_levels > 0) vpack.keypoints.orb_levels = o.orb_levels;
-  if (vpack.keypoints.candidate_limit < vpack.keypoints.max_keypoints)
-    vpack.keypoints.candidate_limit = vpack.keypoints.max_keypoints;
   const VpackExtractor extractor(vpack);
   const NgramSimilarity similarity(similarityConfig(o, preset));
 
