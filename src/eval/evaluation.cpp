@@ -515,7 +515,7 @@ std::vector<Table> tables(const EvalResult& r) {
     const RecognitionScore& c = *r.frame_loop_closure;
     const std::int64_t right = c.top1_correct;
     Table t{"Frame-level loop closures (each frame's detected earlier frame, right when it is a true match at "
-            "least " + std::to_string(std::max(1, r.min_gap)) + " frames back; score: similarity x node probability)",
+            "least " + std::to_string(std::max(1, r.min_gap)) + " frames back; score: frames.csv match_score)",
             {"measure", "value"},
             {}};
     t.rows.push_back({"frames with a true match", std::to_string(c.queries_with_match)});

@@ -232,7 +232,7 @@ namespace {
 SvgPlot loopClosurePlot(const EvalResult& eval) {
   std::vector<PrSeries> curves{{"frame pairs on one node (score: node probability)", eval.loop_closure->points, "#9467bd"}};
   if (eval.frame_loop_closure)
-    curves.push_back({"frame level (score: similarity x node probability)", eval.frame_loop_closure->curve, "#2ca02c"});
+    curves.push_back({"frame level (score: frames.csv match_score)", eval.frame_loop_closure->curve, "#2ca02c"});
   return precisionRecallPlot("loop closure: precision vs. recall", curves);
 }
 /// The topology drawing: HTML (an SVG of the edges under absolutely positioned <div>s with <img>, so the

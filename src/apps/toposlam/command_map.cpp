@@ -38,6 +38,7 @@
 #include "toposlam/segmentation/offline_mapper.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/topology/map_store.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 #include "motion_input.hpp"
 
@@ -58,7 +59,12 @@ struct MapOptions {
   std::string keypoints = "orb";
   SegmentationOptions segmentation;
   MotionOptions motion;
-  int loop_min_gap = 10;  ///< frame-level loop closures: detections at least this many frames back
+  std::string frame_loops = "sequence";  ///< frame-level loop closures: sequence (default) or visits
+  CLI::Option* frame_loops_given = nullptr;
+  int loop_min_gap = 10;  ///< visits: detections at least this many frames back
+  SequenceLoopConfig sequence_loops;  ///< sequence: keyframes, decay, gap
+  double loop_min_gap_s = 20.0;       ///< sequence: detections at least this long back
+  int max_keypoints = -1;             ///< -1: the preset's
   std::string likelihood = toString(methodPreset("default").topology.likelihood);
   double relative_slope = methodPreset("default").topology.relative_slope;
   double relative_offset = methodPreset("default").topology.relative_offset;
@@ -133,7 +139,18 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const MethodPreset preset = presetOf(o.segmentation, "map");
   VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
+  if (o.max_keypoints >= 0) vpack.keypoints.setMaxKeypoints(o.max_keypoints);
   const VpackExtractor extractor(vpack);
+  if (o.frame_loops != "sequence" && o.frame_loops != "visits")
+    throw std::invalid_argument("map: --frame-loops is sequence or visits (got '" + o.frame_loops + "')");
+  // The thesis has no frame-level detector of its own: its preset reads frame closures off the topology.
+  const bool by_sequence =
+      o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
+  SequenceLoopConfig sequence_loops = o.sequence_loops;
+  sequence_loops.min_gap_keyframes = std::max(
+      1, static_cast<int>(std::lround(o.loop_min_gap_s / std::max(sequence_loops.keyframe_interval_s, 1e-9))));
+  if (const std::string problem = sequence_loops.validate(); !problem.empty())
+    throw std::invalid_argument("map: " + problem);
   NgramSimilarityConfig similarity_config = preset.similarity;
   if (o.histogram_weight >= 0) similarity_config.histogram_weight = o.histogram_weight;
   if (o.histogram_gate >= 0) similarity_config.histogram_gate = o.histogram_gate == 1;
@@ -252,8 +269,13 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       if (p < loop.place_probability.size()) loop.place_probability[p] = step.estimate.current_node_probability;
     }
     frame_fingerprints.resize(all.frames.size());
-    const std::vector<FrameMatch> matches = matchFramesToEarlierVisits(
-        place_of_frame, place_nodes, loop.place_probability, frame_fingerprints, similarity, o.loop_min_gap);
+    std::vector<double> time_s;
+    for (const auto& row : all.frames) time_s.push_back(row.time_s);
+    const std::vector<FrameMatch> matches =
+        !by_sequence
+            ? matchFramesToEarlierVisits(place_of_frame, place_nodes, loop.place_probability, frame_fingerprints,
+                                         similarity, o.loop_min_gap)
+            : matchFramesBySequence(time_s, frame_fingerprints, similarity, sequence_loops);
     for (const FrameMatch& m : matches) {
       loop.match_frame.push_back(m.match_frame);
       loop.match_score.push_back(m.score);
@@ -415,10 +437,31 @@ void addMapCommand(CLI::App& app) {
                     ->capture_default_str();
   auto* seed = cmd->add_option("--seed", options->seed, "Seed of the filter's random generator")
                    ->capture_default_str();
+  options->frame_loops_given =
+      cmd->add_option("--frame-loops", options->frame_loops,
+                      "Frame-level loop closures in frames.csv: sequence (evidence of a run of keyframes, "
+                      "docs/topology.md) or visits (the earlier visits of each frame's node; the thesis "
+                      "preset's default)")
+          ->check(CLI::IsMember({"sequence", "visits"}))
+          ->capture_default_str();
   cmd->add_option("--loop-min-gap", options->loop_min_gap,
-                  "Frame-level loop closures: detections at least this many frames back")
+                  "Frame-level loop closures (visits): detections at least this many frames back")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--loop-min-gap-s", options->loop_min_gap_s,
+                  "Frame-level loop closures (sequence): detections at least this many seconds back")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e9));
+  cmd->add_option("--loop-decay", options->sequence_loops.decay,
+                  "Frame-level loop closures (sequence): evidence kept per keyframe, in [0, 1)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.999999));
+  cmd->add_option("--keyframe-interval-s", options->sequence_loops.keyframe_interval_s,
+                  "Frame-level loop closures (sequence): one keyframe at most this often")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--max-keypoints", options->max_keypoints, "Keypoints per frame (default: the preset's)")
+      ->check(CLI::Range(1, 10000));
   cmd->add_option("--histogram-weight", options->histogram_weight, "Similarity: weight of the histogram part (default: the preset's)");
   cmd->add_option("--histogram-gate", options->histogram_gate, "Similarity: histograms as a gate (1) or a weighted part (0)");
   options->likelihood_given =
