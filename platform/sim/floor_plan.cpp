@@ -241,6 +241,13 @@ World parseFloorPlan(const std::string& yaml_text, const std::string& origin) {
       if (node["boards"]) room.boards = readCount(node["boards"], key + ".boards", 10);
       if (node["shelves"]) room.shelves = readCount(node["shelves"], key + ".shelves", 10);
       if (node["desks"]) room.desks = readCount(node["desks"], key + ".desks", 10);
+      if (node["decoration_seed"]) {
+        try {
+          room.decoration_seed = node["decoration_seed"].as<std::uint64_t>();
+        } catch (const YAML::Exception&) {
+          throw std::invalid_argument(key + ".decoration_seed: expected a whole number >= 0");
+        }
+      }
       world.rooms.push_back(room);
     }
     if (const YAML::Node doors = root["doors"]) {
@@ -296,8 +303,12 @@ World loadWorld(const std::string& name_or_path) {
 void decorate(World& world, std::uint64_t seed) {
   world.decor.clear();
   world.furniture.clear();
-  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + 0x1234567ULL);
+  std::mt19937_64 world_rng(seed * 0x9E3779B97F4A7C15ULL + 0x1234567ULL);
   for (const Room& room : world.rooms) {
+    // A room with its own decoration_seed is decorated from it alone: two rooms of one shape with one seed
+    // (and doors at the same places) look the same, whatever the world seed.
+    std::mt19937_64 own_rng(room.decoration_seed ? *room.decoration_seed * 0x9E3779B97F4A7C15ULL + 0x89ABCDEFULL : 0);
+    std::mt19937_64& rng = room.decoration_seed ? own_rng : world_rng;
     const int edges = static_cast<int>(room.polygon.size());
     std::vector<std::vector<Interval>> taken(static_cast<std::size_t>(edges));
     for (int e = 0; e < edges; ++e) taken[static_cast<std::size_t>(e)] = doorIntervals(world, edgeFrame(room, e), 0.35);

@@ -1,6 +1,7 @@
 // Tests of floor plans: YAML parsing and its error messages, the built-in worlds, the decoration.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -97,6 +98,10 @@ TEST_CASE("GIVEN malformed floor plans WHEN parsed THEN the message names the of
   CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\ndoors:\n  - {at: [9, 9]}\n"), Catch::Contains("doors[0].at"));
   CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\nloop: [[1, 1], [9, 9]]\n"), Catch::Contains("loop[1]"));
   CHECK_THAT(errorOf("rooms: [ {rect: [0, 0"), Catch::Contains("test.yaml"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\n    decoration_seed: -3\n"),
+             Catch::Contains("rooms[0].decoration_seed: expected a whole number >= 0"));
+  CHECK_THAT(errorOf("rooms:\n  - rect: [0, 0, 4, 3]\n    decoration_seed: many\n"),
+             Catch::Contains("rooms[0].decoration_seed"));
   CHECK_THROWS_WITH(loadFloorPlanFile("/nonexistent/plan.yaml"), Catch::Contains("/nonexistent/plan.yaml"));
 }
 
@@ -127,4 +132,56 @@ TEST_CASE("GIVEN the built-in worlds WHEN decorated THEN every room is furnished
     decorate(other, 2);
     CHECK(other.decor[0].u0 != world.decor[0].u0);
   }
+}
+
+TEST_CASE("GIVEN two rooms with one shape and one decoration seed WHEN decorated THEN they look alike whatever the world seed",
+          "[sim]") {
+  // tests/data/worlds/twins.yaml: "office A" (room 1) and "office A twin" (room 3) 12 m apart.
+  const std::string path = TOPOSLAM_SAMPLES_DIR "/../worlds/twins.yaml";
+  for (const std::uint64_t seed : {1u, 2u}) {
+    World world = loadFloorPlanFile(path);
+    REQUIRE(world.validate().empty());
+    REQUIRE(world.rooms.size() == 5u);
+    REQUIRE(world.rooms[1].decoration_seed == world.rooms[3].decoration_seed);
+    decorate(world, seed);
+    const auto decor_of = [&](int room) {
+      std::vector<WallDecor> items;
+      for (const WallDecor& d : world.decor)
+        if (d.room == room) items.push_back(d);
+      return items;
+    };
+    const std::vector<WallDecor> a = decor_of(1), twin = decor_of(3);
+    REQUIRE(a.size() == twin.size());
+    REQUIRE(a.size() >= 3u);  // 2 posters, 1 board, and signs
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      CHECK(a[i].edge == twin[i].edge);
+      CHECK(a[i].kind == twin[i].kind);
+      CHECK(a[i].u0 == twin[i].u0);
+      CHECK(a[i].v1 == twin[i].v1);
+      CHECK(a[i].texture_seed == twin[i].texture_seed);
+    }
+    std::vector<Furniture> fa, ftwin;
+    for (const Furniture& f : world.furniture) {
+      if (f.room == 1) fa.push_back(f);
+      if (f.room == 3) ftwin.push_back(f);
+    }
+    REQUIRE(fa.size() == ftwin.size());
+    REQUIRE(fa.size() == 3u);  // 2 shelves, 1 desk
+    for (std::size_t i = 0; i < fa.size(); ++i) {
+      CHECK(std::abs(ftwin[i].centre.x - fa[i].centre.x - 12.0) < 1e-9);  // the twin is 12 m east
+      CHECK(ftwin[i].centre.y == fa[i].centre.y);
+      CHECK(ftwin[i].texture_seed == fa[i].texture_seed);
+    }
+  }
+  // A room without its own seed still follows the world's.
+  World one = loadFloorPlanFile(path), two = loadFloorPlanFile(path);
+  decorate(one, 1);
+  decorate(two, 2);
+  const auto first_of = [](const World& w, int room) {
+    for (const WallDecor& d : w.decor)
+      if (d.room == room) return d.u0;
+    return -1.0;
+  };
+  CHECK(first_of(one, 2) != first_of(two, 2));
+  CHECK(first_of(one, 1) == first_of(two, 1));
 }

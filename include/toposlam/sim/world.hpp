@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct Room {
   int boards = 0;    ///< whiteboards
   int shelves = 1;   ///< bookshelves against the walls
   int desks = 0;
+  /// Decorate this room from its own seed instead of the world's (rooms of one shape, doors and seed are
+  /// look-alikes: the ambiguity the topology filter must carry until later places settle it).
+  std::optional<std::uint64_t> decoration_seed;
 };
 
 struct Door {
