@@ -332,6 +332,15 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
         place_room.push_back(r);
       }
       result.topology = scoreTopology(place_node, place_room);
+      const bool has_pose = std::any_of(truth.labels.begin(), truth.labels.end(),
+                                        [](const LabelRow& l) { return std::isfinite(l.x); });
+      if (has_pose) {
+        std::vector<GroundPose> poses;
+        for (const LabelRow& l : truth.labels) poses.push_back(GroundPose{l.x, l.y, l.heading});
+        std::vector<PlaceSpan> spans;
+        for (const auto& p : run.places) spans.push_back(PlaceSpan{p.first, p.last, static_cast<int>(p.node)});
+        result.place_revisits = scorePlaceRevisits(spans, poses);
+      }
     }
   }
   if (run.topology) {
@@ -454,6 +463,20 @@ void writeEvalJson(std::ostream& out, const EvalResult& r) {
         .field("missed_loop_closures", t.missed_loop_closures);
     json.endObject();
   }
+  if (r.place_revisits) {
+    const PlaceRevisitScore& v = *r.place_revisits;
+    json.key("place_revisits").beginObject();
+    json.field("places", v.places)
+        .field("revisits", v.revisits)
+        .field("closed_right", v.closed_right)
+        .field("missed", v.missed)
+        .field("merged_with_previous", v.merged_with_previous)
+        .field("wrong_closures", v.wrong_closures)
+        .field("radius_m", v.radius_m)
+        .field("max_heading_rad", v.max_heading_rad)
+        .field("min_overlap", v.min_overlap);
+    json.endObject();
+  }
   json.key("best_topology_probability").beginArray();
   for (double p : r.best_topology_probability) json.value(p);
   json.endArray();
@@ -572,6 +595,22 @@ std::vector<Table> tables(const EvalResult& r) {
     t.rows.push_back({"loop closures", std::to_string(s.loop_closures)});
     t.rows.push_back({"wrong loop closures", std::to_string(s.wrong_loop_closures)});
     t.rows.push_back({"missed loop closures", std::to_string(s.missed_loop_closures)});
+    out.push_back(t);
+  }
+  if (r.place_revisits) {
+    const PlaceRevisitScore& v = *r.place_revisits;
+    Table t{"Place revisits by pose (a place revisits the earlier places that saw at least " +
+                fmt("%.0f%%", 100.0 * v.min_overlap) + " of its frames from within " + fmt("%.1f m", v.radius_m) +
+                " and " + fmt("%.0f deg", v.max_heading_rad * 180.0 / 3.14159265358979323846) + ")",
+            {"measure", "value"},
+            {}};
+    t.rows.push_back({"places", std::to_string(v.places)});
+    t.rows.push_back({"revisits", std::to_string(v.revisits)});
+    t.rows.push_back({"closed onto a node they revisit", std::to_string(v.closed_right) + " (" +
+                                                             (v.revisits > 0 ? percent(static_cast<double>(v.closed_right) / v.revisits) : std::string("-")) + ")"});
+    t.rows.push_back({"missed (a new node)", std::to_string(v.missed)});
+    t.rows.push_back({"left on the previous place's node", std::to_string(v.merged_with_previous)});
+    t.rows.push_back({"wrong closures", std::to_string(v.wrong_closures)});
     out.push_back(t);
   }
   if (!r.best_topology_probability.empty()) {

@@ -332,6 +332,78 @@ TopologyScore scoreTopology(const std::vector<int>& place_node, const std::vecto
   return score;
 }
 
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<GroundPose>& poses,
+                                     double radius_m, double max_heading_rad, double min_overlap) {
+  if (!(radius_m > 0) || !(max_heading_rad > 0) || !(min_overlap > 0 && min_overlap <= 1))
+    throw std::invalid_argument("scorePlaceRevisits: radius and heading must be > 0, overlap in (0, 1]");
+  const auto n = static_cast<std::int64_t>(poses.size());
+  for (const PlaceSpan& p : places) {
+    if (p.first < 0 || p.last < p.first || p.last >= n)
+      throw std::invalid_argument("scorePlaceRevisits: place frames " + std::to_string(p.first) + ".." +
+                                  std::to_string(p.last) + " outside the " + std::to_string(n) + " poses");
+  }
+  const auto known = [&](std::int64_t f) {
+    const GroundPose& q = poses[static_cast<std::size_t>(f)];
+    return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.heading);
+  };
+  const auto close = [&](std::int64_t f, std::int64_t g) {
+    const GroundPose& a = poses[static_cast<std::size_t>(f)];
+    const GroundPose& b = poses[static_cast<std::size_t>(g)];
+    const double turn = std::abs(std::remainder(a.heading - b.heading, 2.0 * 3.14159265358979323846));
+    return std::hypot(a.x - b.x, a.y - b.y) <= radius_m && turn <= max_heading_rad;
+  };
+  // Share of place k's known frames that place j covers.
+  const auto overlap = [&](const PlaceSpan& k, const PlaceSpan& j) {
+    int frames = 0, covered = 0;
+    for (std::int64_t f = k.first; f <= k.last; ++f) {
+      if (!known(f)) continue;
+      ++frames;
+      for (std::int64_t g = j.first; g <= j.last; ++g) {
+        if (known(g) && close(f, g)) {
+          ++covered;
+          break;
+        }
+      }
+    }
+    return frames == 0 ? 0.0 : static_cast<double>(covered) / frames;
+  };
+  PlaceRevisitScore score;
+  score.radius_m = radius_m;
+  score.max_heading_rad = max_heading_rad;
+  score.min_overlap = min_overlap;
+  std::set<int> seen_nodes;
+  for (std::size_t k = 0; k < places.size(); ++k) {
+    const int node = places[k].node;
+    if (node < 0) continue;
+    ++score.places;
+    std::set<int> revisited_nodes;
+    bool revisits = false;
+    for (std::size_t j = 0; j + 1 < k; ++j) {  // earlier places other than the previous one
+      if (places[j].node < 0 || overlap(places[k], places[j]) < min_overlap) continue;
+      revisits = true;
+      revisited_nodes.insert(places[j].node);
+    }
+    const bool known_node = seen_nodes.count(node) > 0;
+    const bool stays = k > 0 && places[k - 1].node == node;
+    if (revisits) {
+      ++score.revisits;
+      if (revisited_nodes.count(node) > 0) {
+        ++score.closed_right;
+      } else if (!known_node) {
+        ++score.missed;
+      } else if (stays) {
+        ++score.merged_with_previous;
+      } else {
+        ++score.wrong_closures;
+      }
+    } else if (known_node && !stays) {
+      ++score.wrong_closures;
+    }
+    seen_nodes.insert(node);
+  }
+  return score;
+}
+
 int majority(const std::vector<int>& values) {
   std::map<int, int> counts;
   for (int v : values) {

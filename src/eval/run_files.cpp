@@ -134,6 +134,11 @@ std::vector<LabelRow> loadLabels(const std::string& path) {
   const CsvTable t = readCsv(path);
   const int frame = t.column("frame"), room = t.column("room"), time = t.column("time", false),
             traversal = t.column("traversal", false);
+  const int x = t.column("x", false), y = t.column("y", false), heading = t.column("heading", false);
+  const bool has_pose = x >= 0 || y >= 0 || heading >= 0;
+  if (has_pose && (x < 0 || y < 0 || heading < 0))
+    throw RunFileError(path + ":1: a pose needs all of the columns x, y and heading (found " +
+                       std::string(x >= 0 ? "x " : "") + (y >= 0 ? "y " : "") + (heading >= 0 ? "heading" : "") + ")");
   std::vector<LabelRow> rows;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     LabelRow row;
@@ -154,6 +159,13 @@ std::vector<LabelRow> loadLabels(const std::string& path) {
                            " after traversal " + std::to_string(previous) +
                            " (must be >= 0 and never decrease)");
       }
+    }
+    if (has_pose) {
+      row.x = t.number(r, x);
+      row.y = t.number(r, y);
+      row.heading = t.number(r, heading);
+      if (!std::isfinite(row.x) || !std::isfinite(row.y) || !std::isfinite(row.heading))
+        throw RunFileError(where(t, r) + ": the pose (x, y, heading) must be finite numbers");
     }
     rows.push_back(row);
   }

@@ -225,3 +225,56 @@ SCENARIO(
   CHECK(majority({-1}) == -1);
   CHECK(majority({3, 3, 1}) == 3);
 }
+
+namespace {
+
+/// Two laps of a 30 m straight corridor walked east (0.1 m per frame, heading 0), 300 frames each; a third
+/// stretch walks it back west (heading pi).
+std::vector<GroundPose> twoLapsAndBack() {
+  std::vector<GroundPose> poses;
+  for (int lap = 0; lap < 2; ++lap)
+    for (int i = 0; i < 300; ++i) poses.push_back(GroundPose{0.1 * i, 1.0, 0.0});
+  for (int i = 0; i < 300; ++i) poses.push_back(GroundPose{30.0 - 0.1 * i, 1.0, 3.141592653589793});
+  return poses;
+}
+
+}  // namespace
+
+SCENARIO("GIVEN two laps cut into places WHEN revisits are scored by pose THEN right, missed and wrong closures are counted") {
+  const std::vector<GroundPose> poses = twoLapsAndBack();
+  // Lap 1: places 0-2 (10 m each); lap 2: places 3-5 over the same stretches; the way back: place 6.
+  const auto places = [](std::vector<int> nodes) {
+    std::vector<PlaceSpan> spans;
+    for (int p = 0; p < 7; ++p) spans.push_back(PlaceSpan{100 * p, 100 * p + 99, nodes[static_cast<std::size_t>(p)]});
+    return spans;
+  };
+  GIVEN("lap 2 on lap 1's nodes but its last place on a new node, and the way back new") {
+    const PlaceRevisitScore s = scorePlaceRevisits(places({0, 1, 2, 0, 1, 3, 4}), poses);
+    CHECK(s.places == 7);
+    CHECK(s.revisits == 3);  // places 3-5; the way back looks the other way (heading pi): no revisit
+    CHECK(s.closed_right == 2);
+    CHECK(s.missed == 1);
+    CHECK(s.wrong_closures == 0);
+    CHECK(s.merged_with_previous == 0);
+  }
+  GIVEN("lap 2's first place on the node of lap 1's second, the way back on node 0") {
+    const PlaceRevisitScore s = scorePlaceRevisits(places({0, 1, 2, 1, 1, 2, 0}), poses);
+    CHECK(s.revisits == 3);
+    CHECK(s.closed_right == 2);          // place 4 on node 1 (place 1), place 5 on node 2
+    CHECK(s.wrong_closures == 2);        // place 3 on node 1 (it revisits place 0); place 6 revisits nothing
+    CHECK(s.merged_with_previous == 0);  // place 4 stays on node 1 and revisits place 1 there: right
+  }
+  GIVEN("a place left on the previous place's node that it does not revisit") {
+    const PlaceRevisitScore s = scorePlaceRevisits(places({0, 1, 2, 0, 0, 2, 3}), poses);
+    CHECK(s.closed_right == 2);
+    CHECK(s.merged_with_previous == 1);  // place 4 (revisits place 1) stays on node 0
+  }
+  GIVEN("a tolerance too tight for the half-frame offset of the second lap") {
+    std::vector<GroundPose> shifted = poses;
+    for (std::size_t f = 300; f < 600; ++f) shifted[f].y += 0.5;  // lap 2 half a metre to the side
+    CHECK(scorePlaceRevisits(places({0, 1, 2, 0, 1, 2, 3}), shifted, 0.4).revisits == 0);
+    CHECK(scorePlaceRevisits(places({0, 1, 2, 0, 1, 2, 3}), shifted, 1.0).closed_right == 3);
+  }
+  CHECK_THROWS_AS(scorePlaceRevisits({PlaceSpan{0, 900, 0}}, poses), std::invalid_argument);
+  CHECK_THROWS_AS(scorePlaceRevisits({}, poses, 0.0), std::invalid_argument);
+}

@@ -2,6 +2,8 @@
 // line.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+
 #include "eval_fixture.hpp"
 #include "toposlam/eval/json_reader.hpp"
 #include "toposlam/eval/run_files.hpp"
@@ -67,6 +69,7 @@ SCENARIO("GIVEN the fixture run folder WHEN its files are loaded THEN every fiel
   REQUIRE(labels.size() == 10);
   CHECK(labels[3].room == -1);
   CHECK(labels[4].room == 1);
+  CHECK(labels[4].x == 0.0);  // the fixture has a pose (all zeros)
   const auto timing = loadTiming((dir / "timing.csv").string());
   REQUIRE(timing.size() == 3);
   CHECK(timing[2].filter_ms == Approx(5.0));
@@ -80,6 +83,12 @@ SCENARIO("GIVEN malformed run files WHEN loaded THEN the error names the file an
   writeText(dir / "labels.csv", "frame,time,x\n0,0,0\n");
   CHECK_THROWS_WITH(loadLabels((dir / "labels.csv").string()),
                     Contains("labels.csv:1: missing column 'room'"));
+  writeText(dir / "labels-pose.csv", "frame,room,x,y\n0,1,0,0\n");
+  CHECK_THROWS_WITH(loadLabels((dir / "labels-pose.csv").string()),
+                    Contains("labels-pose.csv:1: a pose needs all of the columns x, y and heading (found x y )"));
+  writeText(dir / "labels-pose2.csv", "frame,room,x,y,heading\n0,1,0,0,north\n");
+  CHECK_THROWS_WITH(loadLabels((dir / "labels-pose2.csv").string()),
+                    Contains("labels-pose2.csv:2: column 'heading': 'north' is not a number"));
   writeText(dir / "labels2.csv", "frame,room\n0,1\n2,1\n");
   CHECK_THROWS_WITH(loadLabels((dir / "labels2.csv").string()),
                     Contains("labels2.csv:3: frame 2 out of order, expected 1"));
@@ -120,4 +129,15 @@ SCENARIO(
   CHECK(pairs[0].query == "41.jpg");
   CHECK(pairs[0].match == "1.jpg");
   CHECK(pairs[0].line == 2);
+}
+
+SCENARIO("GIVEN labels with the camera's pose WHEN loaded THEN x, y and heading are read") {
+  const auto dir = scratchDir("pose");
+  writeText(dir / "labels.csv", "frame,time,room,x,y,heading,traversal\n0,0.0,0,1.5,-2.25,3.1,0\n1,0.2,-1,1.6,-2.25,3.0,0\n");
+  const auto labels = loadLabels((dir / "labels.csv").string());
+  REQUIRE(labels.size() == 2);
+  CHECK(labels[0].x == 1.5);
+  CHECK(labels[0].y == -2.25);
+  CHECK(labels[1].heading == 3.0);
+  CHECK(labels[1].room == -1);
 }

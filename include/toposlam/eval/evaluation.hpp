@@ -87,6 +87,8 @@ struct EvalResult {
   std::optional<std::vector<TraversalCount>> places_per_traversal;
   std::optional<ConsistencyScore> consistency;
   std::optional<TopologyScore> topology;
+  /// Place revisits judged by the camera's pose; needs nodes and labels with x, y, heading (the simulator's).
+  std::optional<PlaceRevisitScore> place_revisits;
   std::vector<double> best_topology_probability;  ///< per filter step, from topology.json
   std::vector<std::string> notes;                 ///< why a measure is missing, etc.
 };

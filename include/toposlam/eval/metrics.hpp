@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -165,6 +166,38 @@ struct TopologyScore {
 /// place_node[k], place_room[k]: the node and ground-truth room of place k in detection order (room -1 =
 /// unknown; such places count for nodes but not for rooms or closures).
 TopologyScore scoreTopology(const std::vector<int>& place_node, const std::vector<int>& place_room);
+
+/// A camera pose of the ground truth (the simulator's labels.csv x, y, heading), NaN when unknown.
+struct GroundPose {
+  double x = std::numeric_limits<double>::quiet_NaN();
+  double y = std::numeric_limits<double>::quiet_NaN();
+  double heading = std::numeric_limits<double>::quiet_NaN();  ///< radians
+};
+
+/// One place of a run: its frames [first, last] and its node in the most probable topology.
+struct PlaceSpan {
+  std::int64_t first = 0, last = 0;
+  int node = -1;
+};
+
+/// Place-level loop closures judged by where the camera was, not by room labels (docs/evaluation.md,
+/// "Place revisits by pose"): place j covers a frame f of place k when one of j's frames was taken within
+/// radius_m of f's position looking within max_heading_rad of its heading; place k revisits the earlier
+/// places (other than k - 1) that cover at least min_overlap of its frames.
+struct PlaceRevisitScore {
+  int places = 0;              ///< places with a node
+  int revisits = 0;            ///< places that revisit an earlier place
+  int closed_right = 0;        ///< revisits on a node of a place they revisit
+  int missed = 0;              ///< revisits on a new node
+  int merged_with_previous = 0;  ///< revisits left on the previous place's node, which they do not revisit
+  int wrong_closures = 0;      ///< places on an earlier node (not the previous place's) none of whose places they revisit
+  double radius_m = 0, max_heading_rad = 0, min_overlap = 0;
+};
+
+/// place spans in time order; poses[f] for every frame (NaN: unknown, never covers nor counts).
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<GroundPose>& poses,
+                                     double radius_m = 1.0, double max_heading_rad = 0.7853981633974483,
+                                     double min_overlap = 0.3);
 
 /// The most frequent value >= 0 among values (smallest on ties), -1 when none.
 int majority(const std::vector<int>& values);

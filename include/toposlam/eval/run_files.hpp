@@ -29,6 +29,11 @@ struct LabelRow {
   /// Which traversal of the route the frame is on (optional column `traversal`, written by `toposlam sim`):
   /// >= 0 and never decreasing down the file; -1 when the file has no such column.
   int traversal = -1;
+  /// The camera's pose (optional columns x, y in metres and heading in radians, written by `toposlam sim`;
+  /// all three or none): NaN when the file has none.
+  double x = std::numeric_limits<double>::quiet_NaN();
+  double y = std::numeric_limits<double>::quiet_NaN();
+  double heading = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One row of frames.csv.
