@@ -54,6 +54,22 @@ RunData loadRun(const std::string& dir) {
   if (fs::exists(root / "dropped_places.csv")) run.dropped_places = loadPlacesWithin("dropped_places.csv");
   if (fs::exists(root / "topology.json")) run.topology = loadTopology((root / "topology.json").string());
   if (fs::exists(root / "timing.csv")) run.timing = loadTiming((root / "timing.csv").string());
+  if (std::ifstream sources(root / "source.txt"); sources) {
+    for (std::string line; std::getline(sources, line);)
+      if (!line.empty()) run.sources.push_back(line);
+  }
+  if (std::ifstream settings(root / "settings.txt"); settings) {
+    int number = 0;
+    for (std::string line; std::getline(settings, line);) {
+      ++number;
+      if (line.empty() || line[0] == '#') continue;
+      const auto eq = line.find(" = ");
+      if (eq == std::string::npos)
+        throw RunFileError((root / "settings.txt").string() + ":" + std::to_string(number) +
+                           ": expected 'key = value', got '" + line + "'");
+      run.settings.emplace_back(line.substr(0, eq), line.substr(eq + 3));
+    }
+  }
   run.traversal_starts.push_back(0);
   for (std::size_t f = 1; f < run.frames.size(); ++f) {
     if (run.frames[f].time_s < run.frames[f - 1].time_s)

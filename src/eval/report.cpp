@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <sstream>
@@ -73,7 +74,10 @@ double percentile(std::vector<double> v, double q) {
 SvgPlot lambda2Plot(const ReportInputs& in) {
   const RunData& run = in.run;
   SvgPlot plot;
-  plot.title = "lambda2 per frame; dashed red: place cuts; solid blue: traversal starts";
+  plot.title = in.rooms.size() == run.frames.size() && !in.rooms.empty()
+                   ? "lambda2 per frame; dashed red: place cuts; green: true room changes; grey: representatives; "
+                     "blue: traversal starts"
+                   : "lambda2 per frame; dashed red: place cuts; grey: representatives; blue: traversal starts";
   plot.x_label = "frame";
   plot.y_label = "lambda2";
   plot.width = 1160;
@@ -87,6 +91,25 @@ SvgPlot lambda2Plot(const ReportInputs& in) {
   const std::vector<std::int64_t> starts = in.eval ? in.eval->traversal_starts : run.traversal_starts;
   for (std::int64_t c : predictedCuts(run, starts)) {
     plot.vertical_lines.push_back(SvgLine{static_cast<double>(c) - 0.5, "#d62728", true, ""});
+  }
+  for (const auto& p : run.places)
+    plot.vertical_lines.push_back(SvgLine{static_cast<double>(p.representative), "#bbbbbb", false, ""});
+  if (in.rooms.size() == run.frames.size()) {
+    // A room change: the first frame in a room other than the last room seen (doorway frames skipped).
+    int last_room = -1;
+    for (std::size_t f = 0; f < in.rooms.size(); ++f) {
+      const int r = in.rooms[f];
+      if (r < 0) continue;
+      if (last_room >= 0 && r != last_room)
+        plot.vertical_lines.push_back(SvgLine{static_cast<double>(f) - 0.5, "#2ca02c", false, ""});
+      last_room = r;
+    }
+  }
+  for (const auto& [key, value] : run.settings) {
+    if (key != "segmentation.gamma") continue;
+    char* end = nullptr;
+    const double gamma = std::strtod(value.c_str(), &end);
+    if (end != value.c_str()) plot.horizontal_lines.push_back(SvgLine{gamma, "#9467bd", true, "gamma"});
   }
   for (std::size_t t = 1; t < starts.size(); ++t) {
     std::string label = "traversal ";
@@ -399,6 +422,22 @@ std::string renderReportHtml(const ReportInputs& in) {
           ".note{color:#a33}\n.legend span{display:inline-block;width:12px;height:12px;margin:0 4px 0 12px}\n"
           "</style></head><body>\n";
   html << "<h1>" << escapeMarkup(in.title) << "</h1>\n";
+  {
+    // What the run was made from and with, and what made this page.
+    html << "<table class=\"eval\"><caption>Run</caption>\n";
+    const auto row = [&](const std::string& key, const std::string& value) {
+      html << "<tr><th style=\"text-align:left\">" << escapeMarkup(key) << "</th><td style=\"text-align:left\">"
+           << escapeMarkup(value) << "</td></tr>\n";
+    };
+    for (std::size_t k = 0; k < run.sources.size(); ++k)
+      row(run.sources.size() == 1 ? "source" : "source " + std::to_string(k + 1), run.sources[k]);
+    if (run.sources.empty()) row("source", "not recorded (no source.txt in the run folder)");
+    for (const auto& [key, value] : run.settings) row(key == "toposlam" ? "made by toposlam" : key, value);
+    if (run.settings.empty()) row("settings", "not recorded (no settings.txt: a run of `segment` or an older `map`)");
+    if (!in.generator.empty()) row("report by", in.generator);
+    if (!in.generated.empty()) row("report made", in.generated);
+    html << "</table>\n";
+  }
   int nodes = 0;
   double best_p = std::nan("");
   if (run.topology) {
@@ -419,9 +458,56 @@ std::string renderReportHtml(const ReportInputs& in) {
   html << "<div>" << stripSvg(colour, by_node ? "node" : "place", 1160) << "</div>\n";
   if (in.rooms.size() == n && n > 0) {
     html << "<div>" << stripSvg(in.rooms, "true room", 1160) << "</div>\n";
+    std::set<int> room_ids(in.rooms.begin(), in.rooms.end());
+    html << "<p class=\"legend\">true rooms:";
+    for (int r : room_ids) html << "<span style=\"background:" << indexColour(r) << "\"></span>" << (r < 0 ? std::string("doorway") : "room " + std::to_string(r));
+    html << "</p>\n";
     html << "<p>Colours of the two strips are independent (node ids and room ids are different numbers); "
-            "grey = "
-            "no place / doorway.</p>\n";
+            "grey = no place / doorway. Which node stands for which room: the table below.</p>\n";
+  }
+  {
+    // Legend: every node (or place) colour, with the room most of its frames are in when rooms are known.
+    std::map<int, std::map<int, int>> rooms_of;  // colour index -> room -> frames
+    for (std::size_t f = 0; f < n; ++f) {
+      if (colour[f] < 0) continue;
+      rooms_of[colour[f]][in.rooms.size() == n ? in.rooms[f] : -2] += 1;
+    }
+    html << "<p class=\"legend\">";
+    for (const auto& [index, rooms] : rooms_of) {
+      int best_room = -2, best = 0, total = 0;
+      for (const auto& [room, count] : rooms) {
+        total += count;
+        if (room >= 0 && count > best) best = count, best_room = room;
+      }
+      html << "<span style=\"background:" << indexColour(index) << "\"></span>" << (by_node ? "node " : "place ")
+           << index;
+      if (best_room >= 0) html << " (room " << best_room << ", " << num(100.0 * best / total, 0) << " %)";
+    }
+    html << "</p>\n";
+    if (by_node && in.rooms.size() == n && n > 0) {
+      // Confusion matrix: frames of each node in each room.
+      std::set<int> room_ids;
+      for (int r : in.rooms) room_ids.insert(r);
+      html << "<table class=\"eval\"><caption>Frames per node (rows) and true room (columns; -1 = doorway); "
+              "the largest cell of each row in bold</caption>\n<tr><th>node</th>";
+      for (int r : room_ids) html << "<th>" << r << "</th>";
+      html << "</tr>\n";
+      for (const auto& [node, rooms] : rooms_of) {
+        int best = 0;
+        for (const auto& [room, count] : rooms)
+          if (room >= 0) best = std::max(best, count);
+        html << "<tr><th><span style=\"display:inline-block;width:10px;height:10px;background:" << indexColour(node)
+             << "\"></span> " << node << "</th>";
+        for (int r : room_ids) {
+          const auto it = rooms.find(r);
+          const int count = it == rooms.end() ? 0 : it->second;
+          html << "<td>" << (count > 0 && count == best && r >= 0 ? "<b>" : "") << (count > 0 ? std::to_string(count) : "")
+               << (count > 0 && count == best && r >= 0 ? "</b>" : "") << "</td>";
+        }
+        html << "</tr>\n";
+      }
+      html << "</table>\n";
+    }
   }
   {
     std::vector<std::int64_t> strip_frames;
@@ -450,6 +536,32 @@ std::string renderReportHtml(const ReportInputs& in) {
   // 2. lambda2
   html << "<h2>Fiedler value lambda2 over time with the place cuts (thesis Figure 4.10)</h2>\n";
   html << "<div>" << inlineSvg(lambda2Plot(in)) << "</div>\n";
+  if (!run.places.empty()) {
+    html << "<h2>Places and their representatives</h2>\n<table class=\"eval\"><tr><th>place</th><th>frames</th>"
+            "<th>representative</th><th>node</th>"
+         << (in.rooms.size() == n ? "<th>true room (share of its frames)</th>" : "") << "</tr>\n";
+    for (const auto& p : run.places) {
+      html << "<tr><td>" << p.place << "</td><td>" << p.first << "-" << p.last << "</td><td>";
+      const auto rep = static_cast<std::size_t>(p.representative);
+      if (rep < in.thumbnails.size() && !in.thumbnails[rep].empty())
+        html << "<img src=\"" << in.thumbnails[rep] << "\" alt=\"frame " << p.representative
+             << "\" style=\"width:96px;height:72px;object-fit:cover;vertical-align:middle\"> ";
+      html << p.representative << "</td><td>" << (p.node >= 0 ? std::to_string(p.node) : "-") << "</td>";
+      if (in.rooms.size() == n) {
+        std::map<int, int> count;
+        for (std::int64_t f = p.first; f <= p.last; ++f) ++count[in.rooms[static_cast<std::size_t>(f)]];
+        int best_room = -1, best = 0;
+        for (const auto& [room, c] : count)
+          if (room >= 0 && c > best) best = c, best_room = room;
+        html << "<td>" << (best_room >= 0 ? std::to_string(best_room) + " (" +
+                                                num(100.0 * best / static_cast<double>(p.last - p.first + 1), 0) + " %)"
+                                          : std::string("-"))
+             << "</td>";
+      }
+      html << "</tr>\n";
+    }
+    html << "</table>\n";
+  }
 
   // 3. topology
   html << "<h2>Most probable topology (thesis Figure 5.4)</h2>\n";
@@ -500,6 +612,15 @@ std::string renderReportHtml(const ReportInputs& in) {
     html << "<p>Ground truth: <code>" << escapeMarkup(in.eval->truth_path) << "</code> (" << in.eval->truth_kind
          << ").</p>\n";
     html << formatEvalHtml(*in.eval);
+    if (in.eval->boundaries && !(in.eval->boundaries->f1 >= 0.5)) {
+      const BoundaryScore& b = *in.eval->boundaries;
+      html << "<p class=\"note\">Why the segmentation score is low: a cut counts only within " << b.tolerance
+           << " frames of the frame where the robot's position changes room. A forward camera sees the next "
+              "room through the doorway before it crosses it, and the corridor only after turning into it, so "
+              "appearance changes (and cuts) fall some frames before entering and after leaving"
+           << (std::isfinite(b.mean_offset) ? " (matched cuts: " + num(b.mean_offset, 1) + " frames on average)" : std::string())
+           << ". The place revisits judged by pose, above, score the places themselves.</p>\n";
+    }
     if (in.eval->loop_closure && !in.eval->loop_closure->points.empty()) {
       html << "<div>" << inlineSvg(loopClosurePlot(*in.eval)) << "</div>\n";
     }
@@ -507,7 +628,15 @@ std::string renderReportHtml(const ReportInputs& in) {
     html << "<p>No ground truth given (<code>--truth labels.csv | GT.bmp | pairs.csv</code>).</p>\n";
   }
 
-  html << "<p id=\"image-check\">images-pending</p>\n"
+  if (!in.pictures.empty()) {
+    html << "<h2>The simulated world</h2>\n";
+    for (const auto& [caption, uri] : in.pictures)
+      html << "<figure style=\"display:inline-block;margin:0 12px 12px 0\"><img src=\"" << uri << "\" alt=\""
+           << escapeMarkup(caption) << "\" style=\"max-width:560px\"><figcaption>" << escapeMarkup(caption)
+           << "</figcaption></figure>\n";
+  }
+  // The page's own image check, for the browser test: kept in the page, not shown.
+  html << "<p id=\"image-check\" hidden>images-pending</p>\n"
           "<script>\nwindow.addEventListener('load', function () {\n"
           "  var images = Array.prototype.slice.call(document.images);\n"
           "  var missing = images.filter(function (i) { return !(i.complete && i.naturalWidth > 0); });\n"

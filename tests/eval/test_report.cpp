@@ -43,8 +43,22 @@ SCENARIO(
       "png;base64,"
       "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8DwHwAFBQIAX8jx0gAAAABJRU5ErkJggg==";
   for (std::int64_t f : wanted) in.thumbnails[static_cast<std::size_t>(f)] = pixel;
+  in.generator = "toposlam 9.9.9";
+  in.generated = "2026-12-02 10:00 UTC";
+  in.pictures.emplace_back("floor plan and route", pixel);
   const std::string html = renderReportHtml(in);
   CHECK_THAT(html, Contains("<!DOCTYPE html>"));
+  // Header: what the run was made from and with (the fixture has neither source.txt nor settings.txt).
+  CHECK_THAT(html, Contains("<caption>Run</caption>"));
+  CHECK_THAT(html, Contains("not recorded (no source.txt in the run folder)"));
+  CHECK_THAT(html, Contains("<td style=\"text-align:left\">toposlam 9.9.9</td>"));
+  CHECK_THAT(html, Contains("2026-12-02 10:00 UTC"));
+  // Legends, node-by-room frames, places with their representatives, the simulator's picture.
+  CHECK_THAT(html, Contains("true rooms:"));
+  CHECK_THAT(html, Contains("Frames per node (rows) and true room"));
+  CHECK_THAT(html, Contains("<h2>Places and their representatives</h2>"));
+  CHECK_THAT(html, Contains("<figcaption>floor plan and route</figcaption>"));
+  CHECK_THAT(html, Contains("<p id=\"image-check\" hidden>"));
   CHECK_THAT(html, Contains("Figure 4.10"));
   CHECK_THAT(html, Contains("Figure 5.4"));
   CHECK_THAT(html, Contains("Figures 5.6/5.7"));
@@ -52,8 +66,9 @@ SCENARIO(
   CHECK_THAT(html, Contains("id=\"image-check\""));
   CHECK_THAT(html, Contains("true room"));
   CHECK_THAT(html, Contains("recall at 100% precision"));
-  // Strip: every frame (n = 10 <= 96 thumbnails); topology: one per node.
-  CHECK(countOf(html, "<img ") == 7 + 2);
+  // Strip: every frame (n = 10 <= 96 thumbnails); topology: one per node; places: one per representative;
+  // the picture.
+  CHECK(countOf(html, "<img ") == 7 + 2 + 3 + 1);
   CHECK(countOf(html, "<svg") >= 6);  // 2 strips, lambda2, topology, probability, timing, PR curve
   CHECK(html.find("src=\"http") == std::string::npos);
   CHECK(html.find("src=\"file") == std::string::npos);

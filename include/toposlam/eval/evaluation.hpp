@@ -12,6 +12,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "toposlam/eval/metrics.hpp"
@@ -29,6 +30,9 @@ struct RunData {
   std::optional<TopologyFile> topology;     ///< topology.json (from `map`)
   std::vector<TimingRow> timing;            ///< timing.csv
   bool has_frame_matches = false;           ///< frames.csv has the match columns of `map`
+  std::vector<std::string> sources;         ///< source.txt: the run's source URIs, one per traversal
+  /// settings.txt ("key = value" lines, written by `map`): what the run was made with, in file order.
+  std::vector<std::pair<std::string, std::string>> settings;
   /// First frame of each traversal: frame 0, then every frame whose time is below the previous frame's
   /// (a new source of `map`), unless set explicitly (evenly split, see splitTraversals).
   std::vector<std::int64_t> traversal_starts;

@@ -17,6 +17,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "toposlam/core/svg_plot.hpp"
@@ -32,6 +33,10 @@ struct ReportInputs {
   /// Per frame: a data URI ("data:image/jpeg;base64,...") of its thumbnail, or empty when not available.
   std::vector<std::string> thumbnails;
   std::vector<std::string> warnings;  ///< shown at the top (e.g. frames not found)
+  std::string generator;              ///< what made the report ("toposlam 0.13.0"), shown in the header
+  std::string generated;              ///< when (UTC date and time), shown in the header
+  /// Pictures shown as they are (caption, data URI): the simulator's map.png and loop_closure.png.
+  std::vector<std::pair<std::string, std::string>> pictures;
 };
 
 /// Frames worth a thumbnail: about `strip_count` evenly spaced frames plus every place's representative.

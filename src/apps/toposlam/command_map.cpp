@@ -253,6 +253,35 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const std::vector<int>& assignment = final_estimate.best.assignment;
   const std::vector<std::int64_t> place_nodes = mapper.placeNodes();
   {
+    // What the run was made with, for the report's header (and a reader of the run folder).
+    const TopologyFilterConfig& topo = filter->config();
+    const auto real = [](double v) {
+      std::ostringstream text;
+      text << v;
+      return text.str();
+    };
+    writeSettingsTxt(out_dir / "settings.txt",
+                     {{"toposlam", TOPOSLAM_VERSION},
+                      {"preset", preset.name},
+                      {"keypoints", std::string(toString(vpack.keypoints.backend)) + ", at most " +
+                                        std::to_string(vpack.keypoints.max_keypoints) + " per frame"},
+                      {"segmentation.window", segmenter_config.window_s > 0
+                                                  ? real(segmenter_config.window_s) + " s (" +
+                                                        std::to_string(segmenter_config.min_window_frames) + "-" +
+                                                        std::to_string(segmenter_config.window) + " frames)"
+                                                  : std::to_string(segmenter_config.window) + " frames"},
+                      {"segmentation.gamma", real(segmenter_config.valley.gamma)},
+                      {"segmentation.delta", real(segmenter_config.valley.delta)},
+                      {"segmentation.cut", toString(segmenter_config.cut_placement)},
+                      {"topology.particles", std::to_string(topo.particles)},
+                      {"topology.likelihood", toString(topo.likelihood)},
+                      {"topology.seed", std::to_string(topo.seed)},
+                      {"frame_loops", by_sequence ? "sequence, decay " + real(sequence_loops.decay) + ", at least " +
+                                                        real(o.loop_min_gap_s) + " s back"
+                                                  : "visits, at least " + std::to_string(o.loop_min_gap) +
+                                                        " frames back"}});
+  }
+  {
     OutputFile out = openOutput(out_dir / "source.txt");
     for (const std::string& uri : o.sources) out << absoluteSourceUri(uri) << "\n";
     out.commit();

@@ -5,6 +5,8 @@
 // found by its frames.csv `name` in its source's folder, or by its position there when that folder holds
 // none of the run's names (see thumbnailPaths).
 #include <algorithm>
+#include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -128,13 +130,51 @@ std::string thumbnailDataUri(const fs::path& path) {
   return "data:image/jpeg;base64," + eval::base64Encode(jpeg);
 }
 
+/// A picture as a PNG data URI, at most 560 px wide; empty when it cannot be read.
+std::string pictureDataUri(const fs::path& path) {
+  cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  if (image.empty()) return "";
+  if (image.cols > 560) cv::resize(image, image, cv::Size(560, std::max(1, image.rows * 560 / image.cols)), 0, 0, cv::INTER_AREA);
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", image, png);
+  return "data:image/png;base64," + eval::base64Encode(png);
+}
+
+/// The report's date, UTC; SOURCE_DATE_EPOCH (seconds) replaces the clock for reproducible pages.
+std::string reportTime() {
+  std::time_t now = std::time(nullptr);
+  if (const char* epoch = std::getenv("SOURCE_DATE_EPOCH"); epoch != nullptr && *epoch != '\0') {
+    char* end = nullptr;
+    const long long seconds = std::strtoll(epoch, &end, 10);
+    if (end != epoch && *end == '\0' && seconds >= 0) now = static_cast<std::time_t>(seconds);
+  }
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[40];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &utc);
+  return text;
+}
+
 void runReport(const ReportCommandOptions& o) {
   eval::ReportInputs in;
   in.run = eval::loadRun(o.run_dir);
   in.title = o.title.empty()
                  ? "toposlam report: " + fs::path(o.run_dir).lexically_normal().filename().string()
                  : o.title;
+  in.generator = "toposlam " TOPOSLAM_VERSION;
+  in.generated = reportTime();
   if (!o.truth.empty()) {
+    // The simulator writes its pictures beside labels.csv: shown as they are.
+    for (const std::string& t : o.truth) {
+      const fs::path folder = fs::path(t).parent_path();
+      for (const auto& [file, caption] : {std::pair<const char*, const char*>{"map.png", "floor plan and route"},
+                                          {"loop_closure.png", "ground-truth loop closures"}}) {
+        const fs::path picture = (folder.empty() ? fs::path(".") : folder) / file;
+        if (!fs::exists(picture)) continue;
+        const std::string uri = pictureDataUri(picture);
+        if (!uri.empty()) in.pictures.emplace_back(std::string(caption) + " (" + picture.string() + ")", uri);
+      }
+    }
     const eval::Truth truth = eval::loadTruth(o.truth);
     in.eval = eval::evaluate(in.run, truth, o.eval);
     if (truth.kind == eval::Truth::Kind::Labels) {

@@ -48,6 +48,13 @@ void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTi
   out.commit();
 }
 
+void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::pair<std::string, std::string>>& settings) {
+  OutputFile out = openOutput(path);
+  out << "# what this run was made with (toposlam map); read by toposlam report\n";
+  for (const auto& [key, value] : settings) out << key << " = " << value << "\n";
+  out.commit();
+}
+
 namespace {
 enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut };
 }  // namespace

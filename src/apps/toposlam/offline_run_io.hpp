@@ -38,6 +38,8 @@ struct FrameTiming {
   std::optional<double> filter_ms;  ///< empty column when the command has no filter (`segment`)
 };
 void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTiming>& rows);
+/// settings.txt of a run folder: what the run was made with, one "key = value" line each (docs/run-folder.md).
+void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::pair<std::string, std::string>>& settings);
 
 /// --preset plus --window-s, --window, --min-window-frames, --gamma, --delta, --similarity-floor,
 /// --min-keypoints, --cut: the preset gives every stage's defaults, an option given overrides its key.
