@@ -184,6 +184,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
   const std::string preset = top.choice("preset", c.preset, {"default", "thesis"});
   if (preset != c.preset) applyPreset(methodPreset(preset), c);
   top.text("source", c.source);
+  c.log_level = top.choice("log_level", c.log_level, {"trace", "debug", "info", "warn", "error"});
 
   {
     Section lcm = top.child("lcm");

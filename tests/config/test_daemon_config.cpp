@@ -31,6 +31,8 @@ SCENARIO("The shipped config documents the defaults in code") {
       CHECK(shipped.validate().empty());
       CHECK(shipped.source == defaults.source);
       CHECK(shipped.source == "sim:office?route=loop2");
+      CHECK(shipped.log_level == defaults.log_level);
+      CHECK(shipped.log_level == "info");
       CHECK(shipped.lcm.url == "udpm://239.255.76.67:7667?ttl=0");
       CHECK(shipped.lcm.place_channel == "TOPOSLAM_PLACE");
       CHECK(shipped.lcm.place_event_channel == "TOPOSLAM_PLACE_EVENT");
@@ -153,6 +155,7 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"pipeline: {threads: {gpu: {}}}", "unknown key 'pipeline.threads.gpu'"},
       {"pipeline: {queues: {frames: 0}}", "pipeline.queues.frames: 0 is out of range, allowed 1 .. 1024"},
       {"pipeline: {queues: {results: 5000}}", "pipeline.queues.results: 5000 is out of range, allowed 1 .. 1024"},
+      {"log_level: verbose", "log_level: 'verbose' is not allowed, expected one of: trace, debug, info, warn, error"},
       {"pipeline: {queues: {overflow: drop_newest}}", "pipeline.queues.overflow: 'drop_newest' is not allowed, expected one of: drop_oldest, block"},
       {"pipeline: {filter_budget_ms: 0}", "pipeline.filter_budget_ms: 0 is out of range, allowed [0.1, 1000] milliseconds"},
       {"pipeline: {status_period_s: 120}", "pipeline.status_period_s: 120 is out of range, allowed [0.1, 60] seconds"},

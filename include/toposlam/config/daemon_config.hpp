@@ -40,6 +40,8 @@ struct DaemonConfig {
   /// Frame source URI (see io/source_factory.hpp): images:PATH, video:FILE, sim:WORLD?..., v4l2:/dev/videoN.
   std::string source = "sim:office?route=loop2";
   LcmSettings lcm;
+  /// log_level: trace, debug, info, warn or error (toposlamd --log-level overrides it).
+  std::string log_level = "info";
   bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
   double map_max_mb = 256;        ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
   bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
