@@ -203,6 +203,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     Section map = top.child("map");
     map.text("path", c.pipeline.map_path, 4096, true);
     map.flag("load_at_start", c.load_map_at_start);
+    map.flag("resume_other_source", c.map_resume_other_source);
     map.real("save_period_s", c.pipeline.map_save_period_s, 0, 86400, " seconds (0 = only at stop)");
     map.real("max_mb", c.map_max_mb, 1, 65536, " MB");
     map.finish();

@@ -29,8 +29,11 @@ SCENARIO("The shipped config documents the defaults in code") {
     const DaemonConfig defaults;
     THEN("it loads and every value equals the default in code") {
       CHECK(shipped.validate().empty());
-      CHECK(shipped.source == defaults.source);
-      CHECK(shipped.source == "sim:office?route=loop2");
+      // The one exception: the installed service reads the camera, the built-in default is the simulator.
+      CHECK(shipped.source == "v4l2:/dev/video0");
+      CHECK(defaults.source == "sim:office?route=loop2");
+      CHECK(shipped.map_resume_other_source == defaults.map_resume_other_source);
+      CHECK_FALSE(shipped.map_resume_other_source);
       CHECK(shipped.log_level == defaults.log_level);
       CHECK(shipped.log_level == "info");
       CHECK(shipped.lcm.url == "udpm://239.255.76.67:7667?ttl=0");

@@ -133,7 +133,9 @@ int runDaemon(const DaemonConfig& config) {
       spdlog::info("toposlamd: removed {} temporary file(s) of interrupted map saves beside {}", orphans,
                    pipeline_config.map_path);
   }
-  const MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
+  // What the map records (and saves) as made with: the fingerprint settings and this run's source.
+  MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
+  map_settings[kMapSourceKey] = mapSourceOf(config.source);
   parts.topology->setMapSettings(map_settings);
   if (config.load_map_at_start && !pipeline_config.map_path.empty()) {
     // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
@@ -142,9 +144,22 @@ int runDaemon(const DaemonConfig& config) {
     RecoveredMap recovered = MapStore::recover(pipeline_config.map_path, *parts.similarity, max_bytes);
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
+      // Another source continues the map only when told to (map.resume_other_source); other fingerprint
+      // settings never do. From then on the map records this source.
+      const MapSettings& recorded = recovered.map->settings;
+      const bool other_source = settingDiffers(recorded, map_settings, kMapSourceKey);
+      MapSettings compared = map_settings;
+      if (config.map_resume_other_source) compared.erase(kMapSourceKey);
       const std::string refusal =
-          MapStore::checkSettings(recovered.map->settings, map_settings, recovered.loaded_from.string());
-      if (!refusal.empty()) throw MapStoreError(refusal);
+          MapStore::checkSettings(recorded, compared, recovered.loaded_from.string());
+      if (!refusal.empty())
+        throw MapStoreError(refusal + (other_source && !config.map_resume_other_source
+                                           ? " (map.resume_other_source: true or --resume-other-source continues "
+                                             "it from this source; --no-map-load starts a new map)"
+                                           : ""));
+      if (other_source)
+        spdlog::warn("toposlamd: the map {} was made from {}; continuing it from {} (map.resume_other_source)",
+                     recovered.loaded_from.string(), recorded.at(kMapSourceKey), map_settings.at(kMapSourceKey));
       parts.topology->adoptMap(std::move(*recovered.map));
       spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
                    parts.topology->observations(),

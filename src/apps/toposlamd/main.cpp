@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
   std::string source, map_path, lcm_url, overflow;
-  bool check_only = false, no_load = false, bench = false;
+  bool check_only = false, no_load = false, bench = false, resume_other_source = false;
   std::string log_level;
   double save_period = -1.0;
   toposlam::daemon::BenchOptions bench_options;
@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
   app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
   app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
   app.add_flag("--no-map-load", no_load, "start a new map even if the map file exists");
+  app.add_flag("--resume-other-source", resume_other_source,
+               "override `map.resume_other_source`: continue a map made from another source");
   app.add_option("--log-level", log_level, "override `log.level`: trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
     if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
     if (save_period >= 0.0) config.pipeline.map_save_period_s = save_period;
     if (no_load) config.load_map_at_start = false;
+    if (resume_other_source) config.map_resume_other_source = true;
     if (!log_level.empty()) config.log_level = log_level;
     spdlog::default_logger()->set_level(*toposlam::parseLogLevel(config.log_level));
     if (std::string problem = config.validate(); !problem.empty())
