@@ -197,6 +197,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     channels.text("motion", c.lcm.motion_channel, 255);
     channels.finish();
     lcm.integer("jpeg_quality", c.lcm.jpeg_quality, 1, 100);
+    lcm.real("open_retry_s", c.lcm.open_retry_s, 0, 3600, " seconds (0 = exit 1 at once)");
     lcm.finish();
   }
   {

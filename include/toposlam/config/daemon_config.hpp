@@ -31,6 +31,9 @@ struct LcmSettings {
   std::string status_channel = "TOPOSLAM_STATUS";        ///< pipeline status, every status period
   std::string motion_channel = "TOPOSLAM_MOTION";        ///< input: robot motion
   int jpeg_quality = 80;                                 ///< place-event thumbnails, 1 .. 100
+  /// Seconds between attempts to open LCM while the host has no route to the multicast group (the
+  /// network is not up yet), 0 .. 3600; 0 = no waiting: exit 1 at once.
+  double open_retry_s = 2.0;
 };
 
 struct DaemonConfig {
