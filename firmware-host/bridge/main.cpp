@@ -6,7 +6,9 @@
 // periodically and at exit.
 //
 // Also: --emulate (an emulated controller on a new pseudo-terminal) and --bench (decoder throughput).
-// Exit codes: 0 done (signal or --duration), 2 bad options or config, 3 cannot open the link, 4 LCM.
+// Exit status, as in toposlam and toposlamd: 0 done (signal or --duration), 1 runtime error (the link or
+// LCM cannot be opened: a restart may help), 2 usage or config error (bad options or config; CLI11's own
+// codes 105-109 are folded into 2).
 #include <signal.h>
 #include <unistd.h>
 
@@ -21,7 +23,6 @@
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "bench.hpp"
@@ -30,6 +31,7 @@
 #include "toposlam/firmware/motion_link.hpp"
 #include "toposlam/firmware/serial_port.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
+#include "toposlam/platform/logging.hpp"
 #include "toposlam_lcm/motion_t.hpp"
 
 namespace {
@@ -61,14 +63,14 @@ int runBridge(const bridge::BridgeConfig& c, double duration_s) {
     stream = openLink(c);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
-    return 3;
+    return 1;
   }
   std::unique_ptr<lcm::LCM> lcm;
   try {
     lcm = openLcm(c.lcm_url);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
-    return 4;
+    return 1;
   }
   const LinkProtocol protocol = *parseProtocol(c.protocol);
   spdlog::info("bridge: {} ({}) -> LCM {} on {}", stream->describe(), protocolName(protocol), c.channel, c.lcm_url);
@@ -209,7 +211,7 @@ int runEmulator(const EmulateOptions& o) {
     opened.emplace(openPseudoTerminal());
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
-    return 3;
+    return 1;
   }
   PseudoTerminal& pty = *opened;
   std::printf("%s\n", pty.slave_path.c_str());
@@ -228,7 +230,7 @@ int runEmulator(const EmulateOptions& o) {
       emulator.advanceTo(std::min(t, emulator.duration()), bytes);
       if (!bytes.empty() && !stream->write(bytes)) {
         spdlog::error("emulator: writing to the pty failed");
-        return 3;
+        return 1;
       }
       if (t >= emulator.duration()) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));  // real-time pacing of the emulated line
@@ -253,6 +255,7 @@ int main(int argc, char** argv) {
   int baud = 0, udp_port = -1;
   double status_period = -1, duration = 0, bench_seconds = 1.0;
   bool bench = false, help_config = false;
+  std::string log_level = "info";
   EmulateOptions emulate;
   std::string emulate_kind;
   app.add_option("-c,--config", config_path, "YAML config (keys: --help-config)");
@@ -265,6 +268,8 @@ int main(int argc, char** argv) {
   app.add_option("--status-period", status_period, "seconds between status lines, 0 = only at exit");
   app.add_option("--duration", duration, "stop after this many seconds (0 = until SIGINT/SIGTERM)");
   app.add_flag("--help-config", help_config, "list the config keys");
+  app.add_option("--log-level", log_level, "log level: trace, debug, info, warn or error (default info)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--bench", bench, "print decoder throughput (MB/s) and exit");
   app.add_option("--bench-seconds", bench_seconds, "seconds per protocol for --bench");
   app.add_option("--emulate", emulate_kind,
@@ -280,9 +285,15 @@ int main(int argc, char** argv) {
   app.add_option("--seed", emulate.seed, "emulator random seed");
   app.add_flag("--loop", emulate.loop, "emulator: repeat the profile until stopped");
   app.add_flag("--other-mavlink", emulate.other_mavlink, "emulator: add MAVLink 1, signed and unknown frames");
-  CLI11_PARSE(app, argc, argv);
-  // Logs go to stderr: stdout carries --emulate's pty path and --bench's figures.
-  spdlog::set_default_logger(spdlog::stderr_color_mt("toposlam-bridge"));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints the help, the version or the usage error
+    return code == 0 ? 0 : 2;      // CLI11's own codes (105-109, ...) are usage errors: 2
+  }
+  // Logs go to stderr (the journal's format under systemd): stdout carries --emulate's pty path and --bench's
+  // figures.
+  toposlam::configureLogging("toposlam-bridge", *toposlam::parseLogLevel(log_level));
 
   signal(SIGINT, onSignal);
   signal(SIGTERM, onSignal);

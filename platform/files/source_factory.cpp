@@ -23,12 +23,14 @@ struct SchemeEntry {
   std::string usage;
 };
 
-// Holds the next frame until it is due; the wait is bounded (nextFor) and ends early on interrupt().
+// Holds the next frame until it is due; the wait is bounded (nextFor) and ends early on interrupt(). Due:
+// frame k at k / rate_hz after the first, or with rate_hz 0 at its timestamp's offset from the first's.
 class RateLimitedSource : public FrameSource {
  public:
   RateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz) : inner_(std::move(inner)), rate_hz_(rate_hz) {}
   std::string describe() const override {
-    return inner_->describe() + " at " + std::to_string(rate_hz_) + " Hz real time";
+    return inner_->describe() +
+           (rate_hz_ > 0 ? " at " + std::to_string(rate_hz_) + " Hz real time" : " at the recorded rate (frame timestamps)");
   }
   std::optional<Frame> next() override {
     for (;;) {
@@ -44,9 +46,13 @@ class RateLimitedSource : public FrameSource {
       const SourceWait wait = inner_->nextFor(timeout, frame);
       if (wait != SourceWait::Frame) return wait;
       const auto now = std::chrono::steady_clock::now();
-      if (delivered_ == 0) start_ = now;
-      due_ = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                          std::chrono::duration<double>(static_cast<double>(delivered_) / rate_hz_));
+      if (delivered_ == 0) {
+        start_ = now;
+        first_timestamp_s_ = frame.timestamp_s;
+      }
+      const double offset_s = rate_hz_ > 0 ? static_cast<double>(delivered_) / rate_hz_
+                                           : std::max(0.0, frame.timestamp_s - first_timestamp_s_);
+      due_ = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(offset_s));
       pending_ = std::move(frame);
     }
     {
@@ -75,7 +81,8 @@ class RateLimitedSource : public FrameSource {
 
  private:
   std::unique_ptr<FrameSource> inner_;
-  double rate_hz_;
+  double rate_hz_;  ///< 0: the recorded rate (frame timestamps)
+  double first_timestamp_s_ = 0.0;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point due_;
   std::optional<Frame> pending_;  ///< taken from the inner source, not yet due
@@ -90,8 +97,12 @@ std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': images: needs a folder, file or glob");
   // Frame timestamps (the segmentation window is in seconds): ?fps=HZ, else the real-time ?rate=HZ,
   // else 1 Hz (the bundled keyframes' rate), said in describe() so a user sees the assumption.
-  const bool given = uri.has("fps") || uri.has("rate");
-  const double hz = uri.has("fps") ? uri.getDouble("fps", 1.0, 1e-3, 1e4) : uri.getDouble("rate", 1.0, 1e-3, 1e4);
+  // rate=recorded takes the times from timestamps.csv beside the frames.
+  const bool recorded = playsAtRecordedRate(uri);
+  const bool given = uri.has("fps") || (uri.has("rate") && !recorded);
+  const double hz = uri.has("fps") ? uri.getDouble("fps", 1.0, 1e-3, 1e4)
+                    : recorded     ? 1.0
+                                   : uri.getDouble("rate", 1.0, 1e-3, 1e4);
   return std::make_unique<ImageFilesSource>(uri.path, hz, uri.getInt("max_pixels", kDefaultMaxImagePixels, 1, 1LL << 32),
                                             given);
 }
@@ -100,7 +111,7 @@ std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
 std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
   uri.requireOnly({});
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': video: needs a file");
-  const double rate = uri.getDouble("rate", 0.0, 1e-3, 1e4);
+  const double rate = playsAtRecordedRate(uri) ? 0.0 : uri.getDouble("rate", 0.0, 1e-3, 1e4);
   using Open = FrameSource* (*)(const char*, double, std::string*);
   const auto open = reinterpret_cast<Open>(sourceModuleSymbol("video", "toposlam_source_video_open_v1"));
   std::string error;
@@ -115,8 +126,8 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, SchemeEntry> schemes;
   Registry() {
-    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ&rate=HZ&max_pixels=N]"};
-    schemes["video"] = {openVideo, "video:FILE[?rate=HZ]"};
+    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ&rate=HZ|recorded&max_pixels=N]"};
+    schemes["video"] = {openVideo, "video:FILE[?rate=HZ|recorded]"};
     schemes["sim"] = {openSim,
                       "sim:WORLD?route=R&fps=F&size=WxH&seed=S[&speed=&fov=&light=day|night|warm|cool&noise=&people=&"
                       "pitch=&moved=0|1&rate=HZ]"};
@@ -178,10 +189,18 @@ std::unique_ptr<FrameSource> openFrameSource(const std::string& text) {
     if (found != entries.schemes.end()) opener = found->second.opener;
   }
   if (!opener) throw FrameSourceError("source '" + text + "': unknown scheme '" + uri.scheme + ":'; use one of:" + schemeList());
-  const double rate = uri.getDouble("rate", 0.0, 1e-3, 1e4);
+  const bool recorded = playsAtRecordedRate(uri);
+  const double rate = recorded ? 0.0 : uri.getDouble("rate", 0.0, 1e-3, 1e4);
   std::unique_ptr<FrameSource> source = opener(uri);
+  if (recorded) source = makeRecordedRateSource(std::move(source));
   if (rate > 0) source = makeRateLimitedSource(std::move(source), rate);
   return source;
+}
+
+bool playsAtRecordedRate(const SourceUri& uri) { return uri.getString("rate", "") == "recorded"; }
+
+std::unique_ptr<FrameSource> makeRecordedRateSource(std::unique_ptr<FrameSource> inner) {
+  return std::make_unique<RateLimitedSource>(std::move(inner), 0.0);
 }
 
 std::unique_ptr<FrameSource> makeRateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz) {

@@ -173,4 +173,12 @@ std::string absoluteSourceUri(const std::string& uri) {
   return prefix + std::filesystem::absolute(parsed.path).lexically_normal().string() + query;
 }
 
+std::string sourceIdentity(const std::string& uri) {
+  const SourceUri parsed = parseSourceUri(uri);
+  if (parsed.scheme.empty() || parsed.scheme == "images" || parsed.scheme == "video")
+    return (parsed.scheme.empty() ? std::string("images") : parsed.scheme) + ":" +
+           std::filesystem::absolute(parsed.path).lexically_normal().string();
+  return parsed.scheme + ":" + parsed.path;
+}
+
 }  // namespace toposlam

@@ -1,9 +1,14 @@
 // LCM sink and subscriber: pipeline records <-> the generated toposlam_lcm message types.
 #include "toposlam/platform/lcm_transport.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -52,6 +57,27 @@ std::unique_ptr<lcm::LCM> openLcm(const std::string& url) {
                              "multicast route (for loopback only: ip link set lo multicast on; "
                              "ip route add 224.0.0.0/4 dev lo)");
   return instance;
+}
+
+std::string lcmRouteProblem(const std::string& url) {
+  const std::string scheme = "udpm://";
+  if (url.rfind(scheme, 0) != 0) return "";
+  // udpm://GROUP:PORT?options; liblcm's defaults when left out.
+  std::string address = url.substr(scheme.size());
+  address = address.substr(0, address.find('?'));
+  std::string group = address.substr(0, address.find(':'));
+  if (group.empty()) group = "239.255.76.67";
+  sockaddr_in destination{};
+  destination.sin_family = AF_INET;
+  destination.sin_port = htons(7667);
+  if (inet_pton(AF_INET, group.c_str(), &destination.sin_addr) != 1) return "";  // liblcm's own error says it
+  const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return std::string("cannot create a UDP socket: ") + std::strerror(errno);
+  const int result = connect(fd, reinterpret_cast<const sockaddr*>(&destination), sizeof destination);
+  const int error = errno;
+  close(fd);
+  if (result == 0) return "";
+  return "no route to the multicast group " + group + ": " + std::strerror(error);
 }
 
 // --------------------------------------------------------------------------------------------------------

@@ -184,6 +184,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
   const std::string preset = top.choice("preset", c.preset, {"default", "thesis"});
   if (preset != c.preset) applyPreset(methodPreset(preset), c);
   top.text("source", c.source);
+  c.log_level = top.choice("log_level", c.log_level, {"trace", "debug", "info", "warn", "error"});
 
   {
     Section lcm = top.child("lcm");
@@ -196,12 +197,14 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     channels.text("motion", c.lcm.motion_channel, 255);
     channels.finish();
     lcm.integer("jpeg_quality", c.lcm.jpeg_quality, 1, 100);
+    lcm.real("open_retry_s", c.lcm.open_retry_s, 0, 3600, " seconds (0 = exit 1 at once)");
     lcm.finish();
   }
   {
     Section map = top.child("map");
     map.text("path", c.pipeline.map_path, 4096, true);
     map.flag("load_at_start", c.load_map_at_start);
+    map.flag("resume_other_source", c.map_resume_other_source);
     map.real("save_period_s", c.pipeline.map_save_period_s, 0, 86400, " seconds (0 = only at stop)");
     map.real("max_mb", c.map_max_mb, 1, 65536, " MB");
     map.finish();

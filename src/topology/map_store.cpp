@@ -142,6 +142,12 @@ std::uint64_t fnv1a64(std::string_view data) {
   return hash;
 }
 
+bool settingDiffers(const MapSettings& recorded, const MapSettings& current, const std::string& key) {
+  const auto a = recorded.find(key);
+  const auto b = current.find(key);
+  return a != recorded.end() && b != current.end() && a->second != b->second;
+}
+
 MapSettings fingerprintMapSettings(const VpackConfig& config) {
   return MapSettings{{"keypoints", toString(config.keypoints.backend)}};
 }

@@ -7,8 +7,14 @@ rm -rf "$dir" && mkdir -p "$dir"
 fail() { echo "FAIL: $*"; exit 1; }
 quoted() { grep -qF -- "$1" "$doc" || fail "docs/deploy.md does not quote: $1"; }
 
-# 1. No multicast route (a network namespace with no route at all).
-line="$(unshare -rn "$toposlamd" --source "images:$samples" --map '' 2>&1 | grep 'error:')"
+# 1. No multicast route (a network namespace with no route at all): toposlamd waits and says so (the log
+#    line without spdlog's time and level), or with lcm.open_retry_s: 0 exits 1 with the error.
+unshare -rn sh -c '"$1" --source "images:$2" --map "" >"$3" 2>&1 & sleep 1; kill -TERM $!; wait' sh "$toposlamd" "$samples" "$dir/wait.log"
+line="$(grep 'waiting for the network' "$dir/wait.log" | sed 's/^\[[^]]*\] \[[a-z]*\] //')"
+[ -n "$line" ] || fail "no 'waiting for the network' line: $(cat "$dir/wait.log")"
+quoted "$line"
+printf 'lcm:\n  open_retry_s: 0\n' >"$dir/no-retry.yaml"
+line="$(unshare -rn "$toposlamd" -c "$dir/no-retry.yaml" --source "images:$samples" --map '' 2>&1 | grep 'error:')"
 [ -n "$line" ] || fail "no LCM error printed"
 quoted "$line"
 # 2. A config error, as the installed file would report it.

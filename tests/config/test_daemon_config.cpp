@@ -29,8 +29,13 @@ SCENARIO("The shipped config documents the defaults in code") {
     const DaemonConfig defaults;
     THEN("it loads and every value equals the default in code") {
       CHECK(shipped.validate().empty());
-      CHECK(shipped.source == defaults.source);
-      CHECK(shipped.source == "sim:office?route=loop2");
+      // The one exception: the installed service reads the camera, the built-in default is the simulator.
+      CHECK(shipped.source == "v4l2:/dev/video0");
+      CHECK(defaults.source == "sim:office?route=loop2");
+      CHECK(shipped.map_resume_other_source == defaults.map_resume_other_source);
+      CHECK_FALSE(shipped.map_resume_other_source);
+      CHECK(shipped.log_level == defaults.log_level);
+      CHECK(shipped.log_level == "info");
       CHECK(shipped.lcm.url == "udpm://239.255.76.67:7667?ttl=0");
       CHECK(shipped.lcm.place_channel == "TOPOSLAM_PLACE");
       CHECK(shipped.lcm.place_event_channel == "TOPOSLAM_PLACE_EVENT");
@@ -38,6 +43,8 @@ SCENARIO("The shipped config documents the defaults in code") {
       CHECK(shipped.lcm.status_channel == "TOPOSLAM_STATUS");
       CHECK(shipped.lcm.motion_channel == "TOPOSLAM_MOTION");
       CHECK(shipped.lcm.jpeg_quality == defaults.lcm.jpeg_quality);
+      CHECK(shipped.lcm.open_retry_s == defaults.lcm.open_retry_s);
+      CHECK(shipped.lcm.open_retry_s == 2.0);
       CHECK(shipped.pipeline.map_path == defaults.pipeline.map_path);
       CHECK(shipped.pipeline.map_save_period_s == defaults.pipeline.map_save_period_s);
       CHECK(shipped.map_max_mb == defaults.map_max_mb);
@@ -153,6 +160,8 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"pipeline: {threads: {gpu: {}}}", "unknown key 'pipeline.threads.gpu'"},
       {"pipeline: {queues: {frames: 0}}", "pipeline.queues.frames: 0 is out of range, allowed 1 .. 1024"},
       {"pipeline: {queues: {results: 5000}}", "pipeline.queues.results: 5000 is out of range, allowed 1 .. 1024"},
+      {"lcm: {open_retry_s: -1}", "lcm.open_retry_s: -1 is out of range, allowed [0, 3600] seconds (0 = exit 1 at once)"},
+      {"log_level: verbose", "log_level: 'verbose' is not allowed, expected one of: trace, debug, info, warn, error"},
       {"pipeline: {queues: {overflow: drop_newest}}", "pipeline.queues.overflow: 'drop_newest' is not allowed, expected one of: drop_oldest, block"},
       {"pipeline: {filter_budget_ms: 0}", "pipeline.filter_budget_ms: 0 is out of range, allowed [0.1, 1000] milliseconds"},
       {"pipeline: {status_period_s: 120}", "pipeline.status_period_s: 120 is out of range, allowed [0.1, 60] seconds"},

@@ -164,9 +164,9 @@ TEST_CASE("GIVEN MAVLink 2 ODOMETRY from a router on UDP localhost WHEN toposlam
   CHECK(bridge.output().find("signed skipped") != std::string::npos);
 }
 
-TEST_CASE("GIVEN no such device WHEN toposlam-bridge starts THEN it exits 3 with an actionable message",
+TEST_CASE("GIVEN no such device WHEN toposlam-bridge starts THEN it exits 1 (a runtime error) with an actionable message",
           "[firmware][bridge]") {
   Bridge bridge({"--serial", "/dev/toposlam-no-such-tty", "--protocol", "wheel"});
   CHECK(bridge.waitForOutput("plugged in", 5000));
-  CHECK(bridge.stop() == 3);
+  CHECK(bridge.stop() == 1);
 }

@@ -58,3 +58,16 @@ TEST_CASE("GIVEN file-source URIs WHEN made absolute THEN relative paths resolve
   CHECK(absoluteSourceUri("sim:office?route=loop2") == "sim:office?route=loop2");
   CHECK(absoluteSourceUri("v4l2:/dev/video0?fps=30") == "v4l2:/dev/video0?fps=30");
 }
+
+TEST_CASE("GIVEN source URIs WHEN a map records them THEN scheme and location count and the query does not", "[io]") {
+  const std::string cwd = std::filesystem::current_path().lexically_normal().string();
+  CHECK(sourceIdentity("sim:office?route=loop2") == "sim:office");
+  CHECK(sourceIdentity("sim:office?route=loop&fps=3") == sourceIdentity("sim:office?route=loop2"));
+  CHECK(sourceIdentity("v4l2:/dev/video0?size=640x480&fps=30&format=yuyv") == "v4l2:/dev/video0");
+  CHECK(sourceIdentity("v4l2:/dev/video0") != sourceIdentity("v4l2:/dev/video1"));
+  CHECK(sourceIdentity("libcamera:1") == "libcamera:1");
+  CHECK(sourceIdentity("images:frames/../run1?rate=5") == "images:" + cwd + "/run1");
+  CHECK(sourceIdentity("run1") == "images:" + cwd + "/run1");
+  CHECK(sourceIdentity("video:/data/clip.mp4?rate=30") == "video:/data/clip.mp4");
+  CHECK(sourceIdentity("IMAGES:/data/run1") == "images:/data/run1");
+}

@@ -31,6 +31,9 @@ struct LcmSettings {
   std::string status_channel = "TOPOSLAM_STATUS";        ///< pipeline status, every status period
   std::string motion_channel = "TOPOSLAM_MOTION";        ///< input: robot motion
   int jpeg_quality = 80;                                 ///< place-event thumbnails, 1 .. 100
+  /// Seconds between attempts to open LCM while the host has no route to the multicast group (the
+  /// network is not up yet), 0 .. 3600; 0 = no waiting: exit 1 at once.
+  double open_retry_s = 2.0;
 };
 
 struct DaemonConfig {
@@ -40,7 +43,11 @@ struct DaemonConfig {
   /// Frame source URI (see io/source_factory.hpp): images:PATH, video:FILE, sim:WORLD?..., v4l2:/dev/videoN.
   std::string source = "sim:office?route=loop2";
   LcmSettings lcm;
+  /// log_level: trace, debug, info, warn or error (toposlamd --log-level overrides it).
+  std::string log_level = "info";
   bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
+  /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
+  bool map_resume_other_source = false;
   double map_max_mb = 256;        ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
   bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
   PipelineConfig pipeline;        ///< queues, threads, budgets; map.path and map.save_period_s land here

@@ -4,7 +4,9 @@
 // plain path (a folder -> images, a video file -> video, an image file -> images). Other platform
 // adapters (v4l2, libcamera) call registerFrameSourceScheme() once at start-up, before opening.
 // The common query key `rate=HZ` plays the source in real time at that rate (the returned source sleeps
-// between frames); without it frames come as fast as they are asked for.
+// between frames); `rate=recorded` plays it at the pace of its own frame timestamps (a recording made by
+// `toposlam capture --record`, whose timestamps.csv the images: source reads); without it frames come as
+// fast as they are asked for.
 // Thread-safety: registering and opening may be called from any thread (the registry is locked).
 #pragma once
 
@@ -33,5 +35,13 @@ std::unique_ptr<FrameSource> openFrameSource(const std::string& uri);
 /// Wraps a source so next() returns frame k no earlier than k / rate_hz seconds after the first call
 /// (sleeps on a steady clock). Timestamps are left as the inner source set them.
 std::unique_ptr<FrameSource> makeRateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz);
+
+/// Wraps a source so next() returns each frame no earlier than its timestamp minus the first frame's
+/// after the first call: the pace it was recorded at (gaps included; a timestamp going back is due at
+/// once). Timestamps are left as they are.
+std::unique_ptr<FrameSource> makeRecordedRateSource(std::unique_ptr<FrameSource> inner);
+
+/// True when `uri` asks for rate=recorded (the openers then leave `rate` to openFrameSource).
+bool playsAtRecordedRate(const SourceUri& uri);
 
 }  // namespace toposlam

@@ -43,4 +43,9 @@ SourceUri parseSourceUri(const std::string& uri);
 /// `toposlam report` finds the frames from any working directory.
 std::string absoluteSourceUri(const std::string& uri);
 
+/// What a map records as the source it was made from: the scheme and location without the query
+/// ("sim:office", "v4l2:/dev/video0", "images:/abs/folder"; file paths absolute as in absoluteSourceUri, a
+/// plain path as "images:PATH"). Rate, size, route and other query keys do not make another source.
+std::string sourceIdentity(const std::string& uri);
+
 }  // namespace toposlam

@@ -8,8 +8,8 @@
 //            bytes(settings)                                   (version 2 on; version 1 has none)
 // where bytes(x) = u64 size + x. The application data is opaque to MapStore (the `map` command keeps
 // its place/frame bookkeeping there). The settings are "key=value" lines that decide whether a map can
-// be continued by a run (the keypoint backend: ORB descriptors mean nothing to a SIFT run);
-// checkSettings() compares them.
+// be continued by a run (the keypoint backend: ORB descriptors mean nothing to a SIFT run; the source,
+// kMapSourceKey: a simulated office is no part of the robot's real map); checkSettings() compares them.
 //
 // Writing is atomic: a temporary file in the same directory is written, fsync'ed, renamed over the
 // target, and the directory is fsync'ed. The file it replaces is kept as "<path>.prev" (a hard link),
@@ -57,6 +57,11 @@ using MapSettings = std::map<std::string, std::string>;
 struct VpackConfig;
 /// The fingerprint settings a map must be continued with: the keypoint backend ("keypoints").
 MapSettings fingerprintMapSettings(const VpackConfig& config);
+/// The setting naming the source a map was made from (io/source_uri.hpp, sourceIdentity: "sim:office",
+/// "v4l2:/dev/video0"). A run from another source continues the map only when told to explicitly.
+inline constexpr const char* kMapSourceKey = "source";
+/// True when both settings have `key` and its values differ (what checkSettings would name for it).
+bool settingDiffers(const MapSettings& recorded, const MapSettings& current, const std::string& key);
 
 class MapStoreError : public std::runtime_error {
  public:

@@ -4,7 +4,12 @@
 // driver's buffer timestamp, i.e. driver-to-application latency, meaningful when the driver stamps
 // buffers with the monotonic clock as V4L2 drivers normally do). It is how the VM test and users check that a
 // camera works before running the daemon. Registering this command also registers the `v4l2:` and
-// `libcamera:` schemes with openFrameSource().
+// `libcamera:` schemes with openFrameSource(). Other source URIs (sim:, images:, video:) are read too (their
+// age_ms is 0: their timestamps are not the monotonic clock).
+//
+// --record DIR writes the frames and their timestamps into DIR (io/frame_recorder.hpp): "record on the
+// robot, re-process on the desk" with `toposlam map images:DIR` or, at the recorded pace,
+// `toposlamd --source "images:DIR?rate=recorded"`.
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -12,12 +17,15 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "commands.hpp"
+#include "toposlam/io/frame_recorder.hpp"
+#include "toposlam/io/source_factory.hpp"
 #include "toposlam/io/v4l2_frame_source.hpp"
 #ifdef TOPOSLAM_HAVE_LIBCAMERA
 #include "toposlam/io/libcamera_frame_source.hpp"
@@ -33,6 +41,9 @@ struct CaptureOptions {
   double timeout_s = 0.0;
   int hold = 0;
   bool quiet = false;
+  std::string record;  ///< --record DIR: "" = nothing recorded
+  FrameRecorderConfig record_config;
+  double record_max_mb = 1024;
 };
 
 /// Calls `stop` after `seconds` unless cancelled first (destruction cancels).
@@ -68,6 +79,7 @@ void runCapture(const CaptureOptions& options) {
   std::function<void()> request_stop;
   std::function<std::int64_t()> reconnects = [] { return std::int64_t{0}; };
   std::function<std::int64_t()> dropped = [] { return std::int64_t{0}; };
+  bool from_camera = true;  // timestamps on CLOCK_MONOTONIC: the age is meaningful
   if (options.uri.rfind("v4l2:", 0) == 0) {
     auto v4l2 = std::make_unique<V4l2FrameSource>(parseV4l2Uri(options.uri));
     V4l2FrameSource* raw = v4l2.get();
@@ -86,13 +98,19 @@ void runCapture(const CaptureOptions& options) {
     throw std::runtime_error("this toposlam was built without libcamera (install libcamera-dev and rebuild)");
 #endif
   } else {
-    throw std::runtime_error(
-        "capture reads cameras: expected v4l2:/dev/videoN?size=WxH&fps=F&format=F or "
-        "libcamera:ID, got '" +
-        options.uri + "'");
+    source = openFrameSource(options.uri);
+    FrameSource* raw = source.get();
+    request_stop = [raw] { raw->interrupt(); };
+    from_camera = false;
   }
   std::printf("source %s\n", source->describe().c_str());
   std::fflush(stdout);
+  std::optional<FrameRecorder> recorder;
+  if (!options.record.empty()) {
+    FrameRecorderConfig config = options.record_config;
+    config.max_bytes = static_cast<std::uint64_t>(options.record_max_mb * 1024.0 * 1024.0);
+    recorder.emplace(options.record, config);
+  }
 
   StopTimer timer(options.timeout_s, request_stop);
   std::vector<Frame> held;  // simulates a slow consumer holding zero-copy buffers
@@ -109,8 +127,14 @@ void runCapture(const CaptureOptions& options) {
     last_t = frame->timestamp_s;
     ++frames;
     const double age_ms =
-        1e3 * (std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() -
-               frame->timestamp_s);
+        from_camera ? 1e3 * (std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() -
+                        frame->timestamp_s)
+               : 0.0;
+    if (recorder && !recorder->record(*frame)) {
+      std::fprintf(stderr, "capture: --record-max-mb %.0f reached after %lld frames; stopping\n", options.record_max_mb,
+                   static_cast<long long>(recorder->frames()));
+      break;
+    }
     ages_ms.push_back(age_ms);
     if (const std::int64_t now = reconnects(); now != seen_reconnects) {
       std::printf("event reconnected reconnects=%lld\n", static_cast<long long>(now));
@@ -143,6 +167,14 @@ void runCapture(const CaptureOptions& options) {
       static_cast<long long>(reconnects()), wall_s, frames > 1 && span_s > 0 ? (frames - 1) / span_s : 0.0,
       quantile(0.5), quantile(0.99));
   std::fflush(stdout);
+  if (recorder) {
+    recorder->finish();
+    std::printf("recorded %lld frames (%.1f MB) into %s; play back: images:%s?rate=recorded\n",
+                static_cast<long long>(recorder->frames()), static_cast<double>(recorder->bytes()) / (1024.0 * 1024.0),
+                options.record.c_str(), options.record.c_str());
+    std::fflush(stdout);
+    if (recorder->full()) return;  // the size bound ended the capture, as asked
+  }
   if (options.count > 0 && frames < options.count)
     throw std::runtime_error("capture: only " + std::to_string(frames) + " of " +
                              std::to_string(options.count) + " frames within " +
@@ -160,11 +192,12 @@ void addCaptureCommand(CLI::App& app) {
   auto options = std::make_shared<CaptureOptions>();
   CLI::App* command = app.add_subcommand("capture",
                                          "Read frames from a camera and print their sequence numbers "
-                                         "and timestamps (checks a camera before running the daemon)");
+                                         "and timestamps (checks a camera before running the daemon); "
+                                         "--record DIR keeps them for replay");
   command
       ->add_option("uri", options->uri,
                    "camera: v4l2:/dev/video0?size=640x480&fps=30&format=yuyv|mjpeg|grey|"
-                   "bgr24|rgb24 or libcamera:ID")
+                   "bgr24|rgb24 or libcamera:ID (or any source URI: sim:, images:, video:)")
       ->required();
   command->add_option("--count,-n", options->count, "frames to read; 0 = until --timeout")
       ->check(CLI::NonNegativeNumber);
@@ -178,6 +211,21 @@ void addCaptureCommand(CLI::App& app) {
                    "keep the last N frames alive (a slow consumer of zero-copy buffers)")
       ->check(CLI::Range(0, 64));
   command->add_flag("--quiet,-q", options->quiet, "print the summary only");
+  command->add_option("--record", options->record,
+                      "write the frames and timestamps.csv into this new or empty folder; replay with "
+                      "images:DIR?rate=recorded");
+  command->add_option("--record-format", options->record_config.format, "jpg or png")
+      ->check(CLI::IsMember({"jpg", "png"}))
+      ->needs("--record")
+      ->capture_default_str();
+  command->add_option("--record-quality", options->record_config.jpeg_quality, "JPEG quality of --record")
+      ->check(CLI::Range(1, 100))
+      ->needs("--record")
+      ->capture_default_str();
+  command->add_option("--record-max-mb", options->record_max_mb, "stop recording (and capturing) at this size")
+      ->check(CLI::Range(0.001, 1e7))
+      ->needs("--record")
+      ->capture_default_str();
   command->callback([options] { runCapture(*options); });
 }
 

@@ -28,6 +28,7 @@
 
 #include "commands.hpp"
 #include "offline_run_io.hpp"
+#include "toposlam/config/daemon_config.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -56,6 +57,7 @@ struct MapOptions {
   std::uint64_t seed = 1;
   int max_representatives = 8;
   std::string resume;
+  bool resume_other_source = false;  ///< --resume-other-source: continue a map made from another source
   std::string keypoints = "orb";
   SegmentationOptions segmentation;
   MotionOptions motion;
@@ -166,10 +168,20 @@ void runMap(const MapOptions& o, bool filter_options_given) {
           "when resuming; drop them or start a new map");
     }
     LoadedMap loaded = MapStore::load(o.resume, similarity);
-    // ORB descriptors mean nothing to a SIFT run (and so on): the map says what it was made with.
-    if (const std::string refusal = MapStore::checkSettings(loaded.settings, fingerprintMapSettings(vpack), o.resume);
-        !refusal.empty())
-      throw std::invalid_argument("map: " + refusal + " (--keypoints)");
+    // ORB descriptors mean nothing to a SIFT run (and so on), and another source (a simulated office, a
+    // camera elsewhere) is no continuation unless the user says so: the map says what it was made with.
+    for (const std::string& uri : o.sources) {
+      MapSettings current = fingerprintMapSettings(vpack);
+      current[kMapSourceKey] = sourceIdentity(uri);
+      std::string hint;
+      if (settingDiffers(loaded.settings, current, "keypoints")) hint += "--keypoints";
+      if (o.resume_other_source)
+        current.erase(kMapSourceKey);
+      else if (settingDiffers(loaded.settings, current, kMapSourceKey))
+        hint += std::string(hint.empty() ? "" : "; ") + "--resume-other-source continues it from this source";
+      if (const std::string refusal = MapStore::checkSettings(loaded.settings, current, o.resume); !refusal.empty())
+        throw ConfigError("map: " + refusal + " (" + hint + ")");
+    }
     filter = std::move(loaded.filter);
     origins = decodeOrigins(loaded.application_data, filter->observationCount());
     for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
@@ -438,7 +450,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
     }
   }
-  MapStore::save(map_path, *filter, encodeOrigins(origins), fingerprintMapSettings(vpack));
+  MapSettings made_with = fingerprintMapSettings(vpack);
+  made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
+  MapStore::save(map_path, *filter, encodeOrigins(origins), made_with);
 
   std::printf(
       "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "
@@ -510,6 +524,9 @@ void addMapCommand(CLI::App& app) {
                    ->check(CLI::Range(1, kTopologyMaxRepresentatives))
                    ->capture_default_str();
   cmd->add_option("--resume", options->resume, "Continue the map in this map.tsm");
+  cmd->add_flag("--resume-other-source", options->resume_other_source,
+                "With --resume: continue a map made from another source (refused otherwise)")
+      ->needs("--resume");
   cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
       ->capture_default_str();
   addSegmentationOptions(*cmd, options->segmentation);

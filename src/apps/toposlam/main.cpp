@@ -7,13 +7,24 @@
 #include <exception>
 #include <iostream>
 
+#include <spdlog/spdlog.h>
+
 #include "commands.hpp"
 #include "toposlam/config/daemon_config.hpp"
+#include "toposlam/platform/logging.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"toposlam: visual topological SLAM for indoor robots with one forward-facing camera"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "toposlam " TOPOSLAM_VERSION);  // project(VERSION), the package version
+  // Log lines of the stages a command runs (sources, pipeline) go to stderr; stdout is the command's output.
+  // --log-level is accepted before or after the command (fallthrough) and applies as soon as it is parsed,
+  // before any command runs.
+  toposlam::configureLogging("toposlam", spdlog::level::info);
+  app.fallthrough();
+  app.add_option("--log-level", "log level: trace, debug, info, warn or error (default info)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
+      ->each([](const std::string& level) { spdlog::default_logger()->set_level(*toposlam::parseLogLevel(level)); });
   toposlam::cli::addFingerprintCommand(app);
   toposlam::cli::addBenchCommand(app);
   toposlam::cli::addMapCommand(app);

@@ -97,6 +97,48 @@ struct Assembly {
   }
 };
 
+/// Until the host has a route to LCM's multicast group (lcm.open_retry_s apart): a service started before
+/// the network must wait for it, not exit and burn systemd's start limit. Says so in the log (at the
+/// first attempt, then once a minute) and in STATUS=; READY=1 at the first miss (started, waiting: no
+/// start timeout), watchdog pings meanwhile. False when a stop signal came first.
+bool waitForNetwork(const DaemonConfig& config, const sigset_t& signals, const SystemdNotifier& notifier,
+                    double watchdog_s, const Clock& clock) {
+  const double period = config.lcm.open_retry_s;
+  if (period <= 0) return true;  // no waiting: opening LCM throws with the hint (exit 1)
+  const double start = clock.now();
+  double last_log = start;
+  int attempts = 0;
+  for (std::string problem; !(problem = lcmRouteProblem(config.lcm.url)).empty();) {
+    ++attempts;
+    const double waited = clock.now() - start;
+    if (attempts == 1) {
+      spdlog::warn("toposlamd: waiting for the network: {} (lcm.url {}); trying again every {} s (the multicast "
+                   "route: docs/deploy.md)", problem, config.lcm.url, period);
+      notifier.ready();
+    } else if (clock.now() - last_log >= 60.0) {
+      spdlog::warn("toposlamd: still waiting for the network after {:.0f} s ({} attempts): {}", waited, attempts, problem);
+      last_log = clock.now();
+    }
+    notifier.status("waiting for the network: " + problem + " (lcm.url " + config.lcm.url + ", attempt " +
+                    std::to_string(attempts) + ")");
+    const double until = clock.now() + period;
+    for (double left = period; left > 0; left = until - clock.now()) {
+      const int signal = waitForSignal(signals, watchdog_s > 0 ? std::min(left, watchdog_s / 2.0) : left);
+      if (signal != 0 && isStopSignal(signal)) {
+        spdlog::info("toposlamd: {} received while waiting for the network: nothing to save, exiting", strsignal(signal));
+        notifier.stopping();
+        return false;
+      }
+      if (signal != 0) spdlog::info("toposlamd: {} received: ignored", strsignal(signal));
+      if (watchdog_s > 0) notifier.watchdog();
+    }
+  }
+  if (attempts > 0)
+    spdlog::info("toposlamd: the network is up after {} attempts ({:.1f} s); opening LCM at {}", attempts + 1,
+                 clock.now() - start, config.lcm.url);
+  return true;
+}
+
 }  // namespace
 
 std::string resolveMapPath(const std::string& path) {
@@ -133,7 +175,9 @@ int runDaemon(const DaemonConfig& config) {
       spdlog::info("toposlamd: removed {} temporary file(s) of interrupted map saves beside {}", orphans,
                    pipeline_config.map_path);
   }
-  const MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
+  // What the map records (and saves) as made with: the fingerprint settings and this run's source.
+  MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
+  map_settings[kMapSourceKey] = mapSourceOf(config.source);
   parts.topology->setMapSettings(map_settings);
   if (config.load_map_at_start && !pipeline_config.map_path.empty()) {
     // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
@@ -142,9 +186,22 @@ int runDaemon(const DaemonConfig& config) {
     RecoveredMap recovered = MapStore::recover(pipeline_config.map_path, *parts.similarity, max_bytes);
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
+      // Another source continues the map only when told to (map.resume_other_source); other fingerprint
+      // settings never do. From then on the map records this source.
+      const MapSettings& recorded = recovered.map->settings;
+      const bool other_source = settingDiffers(recorded, map_settings, kMapSourceKey);
+      MapSettings compared = map_settings;
+      if (config.map_resume_other_source) compared.erase(kMapSourceKey);
       const std::string refusal =
-          MapStore::checkSettings(recovered.map->settings, map_settings, recovered.loaded_from.string());
-      if (!refusal.empty()) throw MapStoreError(refusal);
+          MapStore::checkSettings(recorded, compared, recovered.loaded_from.string());
+      if (!refusal.empty())
+        throw MapStoreError(refusal + (other_source && !config.map_resume_other_source
+                                           ? " (map.resume_other_source: true or --resume-other-source continues "
+                                             "it from this source; --no-map-load starts a new map)"
+                                           : ""));
+      if (other_source)
+        spdlog::warn("toposlamd: the map {} was made from {}; continuing it from {} (map.resume_other_source)",
+                     recovered.loaded_from.string(), recorded.at(kMapSourceKey), map_settings.at(kMapSourceKey));
       parts.topology->adoptMap(std::move(*recovered.map));
       spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
                    parts.topology->observations(),
@@ -153,6 +210,9 @@ int runDaemon(const DaemonConfig& config) {
       spdlog::error("toposlamd: no map file of {} loads; starting a new map", pipeline_config.map_path);
     }
   }
+
+  const double watchdog_s = config.watchdog ? notifier.watchdogPeriodSeconds() : 0.0;
+  if (!waitForNetwork(config, signals, notifier, watchdog_s, clock)) return 0;
 
   // Motion input: counted, and fed to the segmentation's MotionGate (docs/segmentation.md, "Motion-aware
   // segmentation"; motion_t.utime and the pipeline's SteadyClock are both CLOCK_MONOTONIC).
@@ -179,7 +239,6 @@ int runDaemon(const DaemonConfig& config) {
   notifier.status("running: " + parts.source->describe());
   spdlog::info("toposlamd: running; publishing on {} ({})", config.lcm.url, channels.place);
 
-  const double watchdog_s = config.watchdog ? notifier.watchdogPeriodSeconds() : 0.0;
   // Ping twice per watchdog period; otherwise wake once a second for the status line.
   const double tick_s = watchdog_s > 0 ? std::min(1.0, watchdog_s / 2.0) : 1.0;
   bool stopping = false;

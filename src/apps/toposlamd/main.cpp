@@ -15,12 +15,15 @@
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/io/frame_source.hpp"
+#include "toposlam/platform/logging.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace {
 
+bool g_journal = false;  // stderr is the journal: the error line carries its priority, "<3>" (LOG_ERR)
+
 int startError(const std::exception& e, int code) {
-  std::cerr << "toposlamd: error: " << e.what() << "\n";
+  std::cerr << (g_journal ? "<3>" : "") << "toposlamd: error: " << e.what() << "\n";
   return code;
 }
 
@@ -36,7 +39,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
   std::string source, map_path, lcm_url, overflow;
-  bool check_only = false, no_load = false, bench = false;
+  bool check_only = false, no_load = false, bench = false, resume_other_source = false;
+  std::string log_level;
   double save_period = -1.0;
   toposlam::daemon::BenchOptions bench_options;
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
@@ -48,6 +52,10 @@ int main(int argc, char** argv) {
   app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
   app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
   app.add_flag("--no-map-load", no_load, "start a new map even if the map file exists");
+  app.add_flag("--resume-other-source", resume_other_source,
+               "override `map.resume_other_source`: continue a map made from another source");
+  app.add_option("--log-level", log_level, "override `log.level`: trace, debug, info, warn or error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
   app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
   app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
@@ -57,6 +65,9 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);  // prints the help, the version or the usage error
     return code == 0 ? 0 : 2;      // CLI11's own codes (105-109, ...) are usage errors: 2
   }
+  // stderr, in the journal's format under systemd; the level of --log-level, else info until the config
+  // has been read (its log.level then applies).
+  const bool journal = g_journal = toposlam::configureLogging("toposlamd", *toposlam::parseLogLevel(log_level.empty() ? "info" : log_level));
 
   try {
     toposlam::DaemonConfig config;
@@ -74,6 +85,9 @@ int main(int argc, char** argv) {
     if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
     if (save_period >= 0.0) config.pipeline.map_save_period_s = save_period;
     if (no_load) config.load_map_at_start = false;
+    if (resume_other_source) config.map_resume_other_source = true;
+    if (!log_level.empty()) config.log_level = log_level;
+    spdlog::default_logger()->set_level(*toposlam::parseLogLevel(config.log_level));
     if (std::string problem = config.validate(); !problem.empty())
       throw toposlam::ConfigError("command line: " + problem);
     if (check_only) {
@@ -82,7 +96,8 @@ int main(int argc, char** argv) {
       std::cout << "toposlamd: config OK: " << config_path << "\n";
       return 0;
     }
-    spdlog::info("toposlamd: config {}", config_path);
+    spdlog::info("toposlamd: config {}; logging at {} to {}", config_path, config.log_level,
+                 journal ? "the journal (priorities, no timestamps)" : "stderr");
     if (bench) {
       bench_options.source = config.source;
       return toposlam::daemon::runBench(config, bench_options);

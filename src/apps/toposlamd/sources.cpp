@@ -60,6 +60,14 @@ std::string checkSourceUri(const std::string& uri) {
 #endif
 }
 
+std::string mapSourceOf(const std::string& uri) {
+#ifdef TOPOSLAM_HAVE_SOURCES
+  return sourceIdentity(uri);
+#else
+  return uri.substr(0, uri.find('?'));
+#endif
+}
+
 std::unique_ptr<FrameSource> openSource(const std::string& uri) {
 #ifdef TOPOSLAM_HAVE_SOURCES
   registerCameraSchemes();

@@ -13,6 +13,9 @@ namespace toposlam::daemon {
 /// problem. --check-config uses it.
 std::string checkSourceUri(const std::string& uri);
 
+/// The source a map records (io/source_uri.hpp, sourceIdentity): scheme and location, no query.
+std::string mapSourceOf(const std::string& uri);
+
 /// Throws FrameSourceError (or std::invalid_argument for a malformed URI) with an actionable message.
 std::unique_ptr<FrameSource> openSource(const std::string& uri);
 

@@ -39,6 +39,12 @@ struct LcmChannels {
 /// Opens an LCM instance; throws std::runtime_error with a hint (multicast route, URL syntax) on failure.
 std::unique_ptr<lcm::LCM> openLcm(const std::string& url);
 
+/// For a udpm:// URL: "" when the kernel has a route to its multicast group (what liblcm needs to open
+/// it), else why not, e.g. "no route to the multicast group 239.255.76.67: Network is unreachable". Asked
+/// with a UDP socket's connect() (a route look-up; nothing is sent), so it is cheap and prints nothing,
+/// where a failed liblcm open prints a screenful. Other providers (memq://, file://, ...): "".
+std::string lcmRouteProblem(const std::string& url);
+
 /// Microseconds of CLOCK_MONOTONIC (the utime of messages toposlam builds).
 std::int64_t monotonicMicroseconds();
 
