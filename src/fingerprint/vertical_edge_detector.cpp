@@ -30,32 +30,43 @@ VerticalEdgeDetector::VerticalEdgeDetector(const VerticalEdgeConfig& config) : c
 }
 
 VerticalEdges VerticalEdgeDetector::detect(const cv::Mat& grey) const {
+  VerticalEdgeScratch scratch;
+  VerticalEdges result;
+  detect(grey, result, scratch);
+  return result;
+}
+
+void VerticalEdgeDetector::detect(const cv::Mat& grey, VerticalEdges& result,
+                                  VerticalEdgeScratch& scratch) const {
   if (grey.empty()) throw std::invalid_argument("vertical edges: empty image");
   if (grey.type() != CV_8UC1) throw std::invalid_argument("vertical edges: expected an 8-bit grey image");
   const int width = grey.cols;
   const int height = grey.rows;
+  result.column_response.clear();
+  result.threshold = 0.f;
+  result.columns.clear();
 
+  // Three working images, reused from frame to frame: the signed gradient and two 8-bit planes the
+  // morphology below goes back and forth between.
   // 1. |Sobel x|, saturated to 8 bits (the morphology below is fastest on 8-bit data).
-  cv::Mat gradient, magnitude;
-  cv::Sobel(grey, gradient, CV_16S, 1, 0, 3);
-  cv::convertScaleAbs(gradient, magnitude);
+  cv::Sobel(grey, scratch.gradient, CV_16S, 1, 0, 3);
+  cv::convertScaleAbs(scratch.gradient, scratch.plane_a);
   // 2. Horizontal dilation rejoins edges cut by a little roll or a sloping floor.
-  cv::Mat dilated;
-  cv::dilate(magnitude, dilated,
-             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(config_.dilation_width, 1)));
-  // 3. Vertical opening removes segments shorter than a fifth of the height.
+  if (scratch.dilation_kernel.cols != config_.dilation_width)
+    scratch.dilation_kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(config_.dilation_width, 1));
+  cv::dilate(scratch.plane_a, scratch.plane_b, scratch.dilation_kernel);
+  // 3. Vertical opening (erosion, then dilation) removes segments shorter than a fifth of the height.
   const int opening = std::clamp(static_cast<int>(std::lround(config_.opening_height_fraction * height)), 1,
                                  height);
-  cv::Mat opened;
-  cv::morphologyEx(dilated, opened, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(1, opening)));
-  // 4. Column response, normalised to a maximum of 1.
-  cv::Mat column_sums;
-  cv::reduce(opened, column_sums, 0, cv::REDUCE_SUM, CV_32F);
-  VerticalEdges result;
-  result.column_response.assign(column_sums.ptr<float>(0), column_sums.ptr<float>(0) + width);
+  if (scratch.opening_kernel.rows != opening)
+    scratch.opening_kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(1, opening));
+  cv::erode(scratch.plane_b, scratch.plane_a, scratch.opening_kernel);
+  cv::dilate(scratch.plane_a, scratch.plane_b, scratch.opening_kernel);
+  // 4. Column response, normalised to a maximum of 1 (the sums are whole numbers below 2^24: exact).
+  cv::reduce(scratch.plane_b, scratch.column_sums, 0, cv::REDUCE_SUM, CV_32F);
+  result.column_response.assign(scratch.column_sums.ptr<float>(0), scratch.column_sums.ptr<float>(0) + width);
   const float peak = *std::max_element(result.column_response.begin(), result.column_response.end());
-  if (peak <= 0.f) return result;  // no structure at all: no edges
+  if (peak <= 0.f) return;  // no structure at all: no edges
   double total = 0.0;
   for (float& v : result.column_response) {
     v /= peak;
@@ -63,13 +74,12 @@ VerticalEdges VerticalEdgeDetector::detect(const cv::Mat& grey) const {
   }
   // 5. Keep columns above mean_factor x the mean.
   result.threshold = static_cast<float>(config_.mean_factor * total / width);
-  std::vector<float> kept(result.column_response);
-  for (float& v : kept)
+  scratch.kept.assign(result.column_response.begin(), result.column_response.end());
+  for (float& v : scratch.kept)
     if (v <= result.threshold) v = 0.f;
   // 6. Minimum separation between edges.
   const int half_width = std::max(1, static_cast<int>(std::lround(config_.min_separation_fraction * width)));
-  result.columns = nonMaximumSuppression1d(kept, half_width);
-  return result;
+  result.columns = nonMaximumSuppression1d(scratch.kept, half_width);
 }
 
 // ---------------------------------------------------------------------------------------------------

@@ -26,11 +26,23 @@ struct VerticalEdges {
   std::vector<int> columns;            ///< edge columns, ascending
 };
 
+/// The working images of one detection. Kept by a caller that detects frame after frame, so frames of
+/// one size reuse the same memory; used by one detection at a time.
+struct VerticalEdgeScratch {
+  cv::Mat gradient;          ///< CV_16S, Sobel x
+  cv::Mat plane_a, plane_b;  ///< CV_8U, |gradient| and the morphology's steps
+  cv::Mat column_sums;       ///< 1 x width, CV_32F
+  cv::Mat dilation_kernel, opening_kernel;
+  std::vector<float> kept;  ///< the column response above the threshold
+};
+
 class VerticalEdgeDetector {
  public:
   explicit VerticalEdgeDetector(const VerticalEdgeConfig& config = {});
   /// grey: CV_8UC1 image. Throws std::invalid_argument on an empty or non-8-bit-grey image.
   VerticalEdges detect(const cv::Mat& grey) const;
+  /// The same into `result`, working in `scratch` (both reused from frame to frame).
+  void detect(const cv::Mat& grey, VerticalEdges& result, VerticalEdgeScratch& scratch) const;
 
  private:
   VerticalEdgeConfig config_;
