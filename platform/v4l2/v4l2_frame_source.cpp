@@ -241,7 +241,12 @@ std::string V4l2FrameSource::describe() const {
   return text.str();
 }
 
-std::int64_t V4l2FrameSource::skippedFrames() const { return status().skipped; }
+// Read every frame by the capture thread: one counter under the lock, not a copy of the whole status
+// (its strings included).
+std::int64_t V4l2FrameSource::skippedFrames() const {
+  std::lock_guard lock(status_mutex_);
+  return status_.skipped;
+}
 
 FrameSourceState V4l2FrameSource::state() const {
   std::lock_guard lock(status_mutex_);
@@ -252,7 +257,10 @@ FrameSourceState V4l2FrameSource::state() const {
   state.dropped = status_.dropped;
   return state;
 }
-std::int64_t V4l2FrameSource::droppedFrames() const { return status().dropped; }
+std::int64_t V4l2FrameSource::droppedFrames() const {
+  std::lock_guard lock(status_mutex_);
+  return status_.dropped;
+}
 
 V4l2SourceStatus V4l2FrameSource::status() const {
   std::lock_guard lock(status_mutex_);

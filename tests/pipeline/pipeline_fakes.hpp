@@ -195,7 +195,7 @@ class FakeTopology final : public TopologyStage {
     return std::nullopt;
   }
   bool idle() const override { return queue_.empty(); }
-  PlaceEstimate estimate() const override { return estimate_; }
+  const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override {
     TopologySnapshot t;
     t.map_revision = revision_;

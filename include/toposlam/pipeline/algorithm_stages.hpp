@@ -5,12 +5,12 @@
 
 #include <cstdint>
 #include <deque>
-#include <map>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -79,7 +79,9 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 
   FiedlerSegmenter segmenter_;
   std::size_t max_thumbnails_;
-  std::map<std::int64_t, cv::Mat> thumbnails_;  ///< frame -> thumbnail, frames of the open place
+  /// (frame, thumbnail) of the open place's frames, in arrival order; capacity max_thumbnails_ reserved
+  /// once, so a frame costs no node allocation.
+  std::vector<std::pair<std::int64_t, cv::Mat>> thumbnails_;
   std::int64_t dropped_places_ = 0;
 
   MotionGate gate_;
@@ -112,7 +114,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   void enqueuePlace(const ClosedPlace& place) override;
   std::optional<PlaceAssignment> advance(double budget_s) override;
   bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
-  PlaceEstimate estimate() const override { return estimate_; }
+  const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override { return topology_; }
   std::unique_ptr<const MapSnapshot> snapshotMap() const override;
 
