@@ -1,4 +1,4 @@
-// Conversion of camera buffers to BGR images (camera_pixels.hpp).
+// Conversion of camera buffers to the pipeline's images (camera_pixels.hpp).
 #include "camera_pixels.hpp"
 
 #include <opencv2/imgcodecs.hpp>
@@ -60,6 +60,48 @@ cv::Mat cameraBufferToBgr(CameraPixelLayout layout, const std::uint8_t* data, st
       break;
   }
   return bgr;
+}
+
+const std::array<std::uint8_t, 256>& yuyvLumaToGrey() {
+  // Made by the decoder itself: one row of 256 pixels, Y = 0..255 with U = V = 128, decoded to BGR;
+  // with neutral chroma B = G = R, which BGR-to-grey leaves as it is.
+  static const std::array<std::uint8_t, 256> table = [] {
+    std::array<std::uint8_t, 512> yuyv{};
+    for (int x = 0; x < 256; ++x) {
+      yuyv[static_cast<std::size_t>(2 * x)] = static_cast<std::uint8_t>(x);
+      yuyv[static_cast<std::size_t>(2 * x + 1)] = 128;
+    }
+    cv::Mat bgr;
+    cv::cvtColor(cv::Mat(1, 256, CV_8UC2, yuyv.data()), bgr, cv::COLOR_YUV2BGR_YUYV);
+    std::array<std::uint8_t, 256> t{};
+    for (int x = 0; x < 256; ++x) t[static_cast<std::size_t>(x)] = bgr.at<cv::Vec3b>(0, x)[1];
+    return t;
+  }();
+  return table;
+}
+
+CameraImages cameraBufferToImages(CameraPixelLayout layout, const std::uint8_t* data, std::size_t bytes,
+                                  int width, int height, std::size_t stride) {
+  CameraImages out;
+  if (layout == CameraPixelLayout::Grey) {
+    const std::size_t needed = packedImageBytes(layout, width, height, stride);
+    if (needed == 0 || bytes < needed) return out;
+    // OpenCV only reads through this header; it wants a non-const pointer.
+    out.image = cv::Mat(height, width, CV_8UC1, const_cast<std::uint8_t*>(data), stride).clone();
+    out.grey = out.image;
+    return out;
+  }
+  out.image = cameraBufferToBgr(layout, data, bytes, width, height, stride);
+  if (layout == CameraPixelLayout::Yuyv && !out.image.empty()) {
+    const std::array<std::uint8_t, 256>& to_grey = yuyvLumaToGrey();
+    out.grey.create(height, width, CV_8UC1);
+    for (int y = 0; y < height; ++y) {
+      const std::uint8_t* in = data + static_cast<std::size_t>(y) * stride;  // Y0 U Y1 V ...
+      std::uint8_t* row = out.grey.ptr<std::uint8_t>(y);
+      for (int x = 0; x < width; ++x) row[x] = to_grey[in[2 * x]];
+    }
+  }
+  return out;
 }
 
 }  // namespace toposlam

@@ -659,7 +659,9 @@ std::optional<Frame> V4l2FrameSource::handleBuffer(const ::v4l2_buffer& buffer) 
         stream->buffer_returned.notify_all();
       });
     } else {
-      frame.image = cameraBufferToBgr(layout, data, used, width_, height_, bytes_per_line_);
+      CameraImages images = cameraBufferToImages(layout, data, used, width_, height_, bytes_per_line_);
+      frame.image = std::move(images.image);
+      frame.grey = std::move(images.grey);
       if (frame.image.empty()) return skip(&V4l2SourceStatus::decode_failures, "conversion failed");
       requeue(buffer.index);
     }

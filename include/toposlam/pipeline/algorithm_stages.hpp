@@ -28,7 +28,9 @@ class WorkerPool;
 class VpackFingerprintStage final : public FingerprintStage {
  public:
   VpackFingerprintStage(const VpackConfig& config, WorkerPool* pool) : extractor_(config, pool) {}
-  Fingerprint process(const cv::Mat& image) override { return extractor_.extract(image); }
+  Fingerprint process(const cv::Mat& image, const cv::Mat& grey) override {
+    return extractor_.extract(image, grey);
+  }
 
  private:
   VpackExtractor extractor_;

@@ -90,7 +90,8 @@ struct TopologySnapshot {
 class FingerprintStage {
  public:
   virtual ~FingerprintStage() = default;
-  virtual Fingerprint process(const cv::Mat& image) = 0;
+  /// image: the frame (BGR, or grey); grey: the camera's own grey of it, or empty (Frame::grey).
+  virtual Fingerprint process(const cv::Mat& image, const cv::Mat& grey) = 0;
 };
 
 /// Fingerprint -> Fiedler value and, now and then, a closed place. Called for every frame, in order.
