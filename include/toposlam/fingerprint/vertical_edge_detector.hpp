@@ -4,6 +4,7 @@
 // minimum separation of 5 % of the width. n edges split the frame into n+1 ordered subregions.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -26,14 +27,15 @@ struct VerticalEdges {
   std::vector<int> columns;            ///< edge columns, ascending
 };
 
-/// The working images of one detection. Kept by a caller that detects frame after frame, so frames of
-/// one size reuse the same memory; used by one detection at a time.
+/// The working memory of one detection. Kept by a caller that detects frame after frame, so frames of
+/// one size need no new memory; used by one detection at a time.
 struct VerticalEdgeScratch {
-  cv::Mat gradient;          ///< CV_16S, Sobel x
-  cv::Mat plane_a, plane_b;  ///< CV_8U, |gradient| and the morphology's steps
-  cv::Mat column_sums;       ///< 1 x width, CV_32F
-  cv::Mat dilation_kernel, opening_kernel;
-  std::vector<float> kept;  ///< the column response above the threshold
+  std::vector<std::uint8_t> magnitude;        ///< one row of |Sobel x|
+  std::vector<std::uint8_t> dilated, eroded;  ///< height x width
+  std::vector<std::uint8_t> prefix, suffix;   ///< the opening's running extrema, (height + k - 1) x width
+  std::vector<std::uint8_t> identity_row;     ///< rows outside the image
+  std::vector<std::uint32_t> sums;            ///< column sums of the opened image
+  std::vector<float> kept;                    ///< the column response above the threshold
 };
 
 class VerticalEdgeDetector {
@@ -45,6 +47,9 @@ class VerticalEdgeDetector {
   void detect(const cv::Mat& grey, VerticalEdges& result, VerticalEdgeScratch& scratch) const;
 
  private:
+  /// Steps 1-4 into scratch.sums.
+  void columnResponse(const cv::Mat& grey, VerticalEdgeScratch& scratch) const;
+
   VerticalEdgeConfig config_;
 };
 
