@@ -62,6 +62,29 @@ cv::Mat cameraBufferToBgr(CameraPixelLayout layout, const std::uint8_t* data, st
   return bgr;
 }
 
+std::vector<std::uint8_t> bgrToYuyv(const cv::Mat& bgr) {
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(bgr.rows) * static_cast<std::size_t>(bgr.cols / 2) *
+                                4);
+  std::size_t k = 0;
+  for (int y = 0; y < bgr.rows; ++y) {
+    for (int x = 0; x + 1 < bgr.cols; x += 2) {
+      double u = 0.0, v = 0.0, luma[2];
+      for (int i = 0; i < 2; ++i) {
+        const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x + i);
+        const double b = p[0], g = p[1], r = p[2];
+        luma[i] = 16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0;
+        u += 128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0;
+        v += 128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0;
+      }
+      out[k++] = cv::saturate_cast<std::uint8_t>(luma[0]);
+      out[k++] = cv::saturate_cast<std::uint8_t>(u / 2.0);
+      out[k++] = cv::saturate_cast<std::uint8_t>(luma[1]);
+      out[k++] = cv::saturate_cast<std::uint8_t>(v / 2.0);
+    }
+  }
+  return out;
+}
+
 const std::array<std::uint8_t, 256>& yuyvLumaToGrey() {
   // Made by the decoder itself: one row of 256 pixels, Y = 0..255 with U = V = 128, decoded to BGR;
   // with neutral chroma B = G = R, which BGR-to-grey leaves as it is.

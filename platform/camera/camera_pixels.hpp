@@ -11,6 +11,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <opencv2/core/mat.hpp>
 
@@ -51,6 +52,11 @@ struct CameraImages {
 /// coloured ones it differs by the decoder's per-channel clipping and rounding (docs/performance.md).
 CameraImages cameraBufferToImages(CameraPixelLayout layout, const std::uint8_t* data, std::size_t bytes,
                                   int width, int height, std::size_t stride);
+
+/// What a YUYV camera delivers of a BGR image (CV_8UC3, even width): BT.601 video range (Y 16..235),
+/// the chroma of each pixel pair averaged, rows packed (stride = 2 x width). For tests and benchmarks
+/// that play recorded colour frames as a YUYV camera.
+std::vector<std::uint8_t> bgrToYuyv(const cv::Mat& bgr);
 
 /// The table behind the Yuyv luma: video-range Y (16..235) to grey (0..255).
 const std::array<std::uint8_t, 256>& yuyvLumaToGrey();

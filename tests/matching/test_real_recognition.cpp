@@ -24,6 +24,7 @@
 #include "toposlam/matching/similarity_preset.hpp"
 
 using namespace toposlam;
+using toposlam::bgrToYuyv;
 using toposlam::CameraImages;
 using toposlam::CameraPixelLayout;
 
@@ -129,30 +130,6 @@ std::string figures(const eval::RecognitionScore& s) {
          std::to_string(s.recall_at_full_precision);
 }
 
-// What a YUYV camera would deliver of a BGR frame: BT.601 video range (Y 16..235), the chroma of each
-// pixel pair averaged (4:2:2), rows packed without padding.
-std::vector<std::uint8_t> toYuyv(const cv::Mat& bgr) {
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(bgr.rows) * static_cast<std::size_t>(bgr.cols) * 2);
-  std::size_t k = 0;
-  for (int y = 0; y < bgr.rows; ++y) {
-    for (int x = 0; x + 1 < bgr.cols; x += 2) {
-      double u = 0.0, v = 0.0, luma[2];
-      for (int i = 0; i < 2; ++i) {
-        const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x + i);
-        const double b = p[0], g = p[1], r = p[2];
-        luma[i] = 16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0;
-        u += 128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0;
-        v += 128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0;
-      }
-      out[k++] = cv::saturate_cast<std::uint8_t>(luma[0]);
-      out[k++] = cv::saturate_cast<std::uint8_t>(u / 2.0);
-      out[k++] = cv::saturate_cast<std::uint8_t>(luma[1]);
-      out[k++] = cv::saturate_cast<std::uint8_t>(v / 2.0);
-    }
-  }
-  return out;
-}
-
 struct CameraPathScore {
   eval::RecognitionScore via_bgr;    ///< YUYV -> BGR -> grey for edges and keypoints (before issue 18)
   eval::RecognitionScore via_luma;   ///< YUYV -> BGR for histograms, the luma for edges and keypoints
@@ -171,7 +148,7 @@ CameraPathScore scoreCameraPaths(const Frames& queries, const Frames& references
   auto fingerprint = [&](const Frames& set, std::vector<Fingerprint>& via_bgr,
                          std::vector<Fingerprint>& via_luma) {
     for (const cv::Mat& image : set.images) {
-      const std::vector<std::uint8_t> yuyv = toYuyv(image);
+      const std::vector<std::uint8_t> yuyv = bgrToYuyv(image);  // as a YUYV camera delivers it
       const std::size_t stride = static_cast<std::size_t>(image.cols) * 2;
       via_bgr.push_back(extractor.extract(cameraBufferToBgr(CameraPixelLayout::Yuyv, yuyv.data(), yuyv.size(),
                                                             image.cols, image.rows, stride)));
