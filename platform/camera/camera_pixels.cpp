@@ -116,12 +116,18 @@ CameraImages cameraBufferToImages(CameraPixelLayout layout, const std::uint8_t* 
   }
   out.image = cameraBufferToBgr(layout, data, bytes, width, height, stride);
   if (layout == CameraPixelLayout::Yuyv && !out.image.empty()) {
-    const std::array<std::uint8_t, 256>& to_grey = yuyvLumaToGrey();
+    // yuyvLumaToGrey() as arithmetic the compiler vectorises (16-bit lanes): min(255, (max(Y - 16, 0)
+    // x 149 + 62) >> 7) equals the table for all 256 values (tested); a table look-up per pixel cost
+    // more than the BGR-to-grey conversion it replaces.
     out.grey.create(height, width, CV_8UC1);
     for (int y = 0; y < height; ++y) {
       const std::uint8_t* in = data + static_cast<std::size_t>(y) * stride;  // Y0 U Y1 V ...
       std::uint8_t* row = out.grey.ptr<std::uint8_t>(y);
-      for (int x = 0; x < width; ++x) row[x] = to_grey[in[2 * x]];
+      for (int x = 0; x < width; ++x) {
+        const std::uint16_t above_black = in[2 * x] > 16 ? static_cast<std::uint16_t>(in[2 * x] - 16) : 0;
+        const auto grey = static_cast<std::uint16_t>((above_black * 149 + 62) >> 7);
+        row[x] = static_cast<std::uint8_t>(grey > 255 ? 255 : grey);
+      }
     }
   }
   return out;

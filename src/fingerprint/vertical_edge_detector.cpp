@@ -40,7 +40,8 @@ int reflect101(int i, int n) {
 /// One opening pass along the columns (a window of `k` rows, anchor k / 2, rows outside ignored) over
 /// `rows` rows of `width` bytes: the minimum (erosion) or maximum (dilation) of each window, by van
 /// Herk and Gil-Werman's running extrema per block of k rows (three operations per pixel for any k).
-/// `prefix` and `suffix` hold (rows + k - 1) rows. `out_row(y)` receives row y of the result.
+/// `prefix` and `suffix` hold (rows + k - 1) rows. `out_row(y, suffix_row, prefix_row)` gets row y of the
+/// result as the two rows whose pixelwise extreme it is.
 template <bool kMinimum, typename Out>
 void columnExtrema(const std::uint8_t* in, int rows, int width, int k, std::vector<std::uint8_t>& prefix,
                    std::vector<std::uint8_t>& suffix, std::vector<std::uint8_t>& identity_row,

@@ -101,6 +101,9 @@ SCENARIO(
       CHECK(cv::norm(images.image, bgr, cv::NORM_INF) == 0);
       REQUIRE(images.grey.type() == CV_8UC1);
       CHECK(cv::norm(images.grey.row(0), round_trip.row(0), cv::NORM_INF) == 0);
+      for (int level = 0; level < 256; ++level)  // the table, and the arithmetic that stands for it
+        CHECK(images.grey.at<std::uint8_t>(0, level) ==
+              toposlam::yuyvLumaToGrey()[static_cast<std::size_t>(level)]);
       CHECK(images.grey.at<std::uint8_t>(0, 16) == 0);     // video black
       CHECK(images.grey.at<std::uint8_t>(0, 235) == 255);  // video white
     }
