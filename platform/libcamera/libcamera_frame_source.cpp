@@ -357,7 +357,10 @@ SourceWait LibcameraFrameSource::nextFor(std::chrono::milliseconds timeout, Fram
       // Packed layouts: the whole mapped plane; JPEG: the bytes the camera wrote.
       const std::size_t bytes =
           impl.layout == CameraPixelLayout::Jpeg ? std::min(used, mapping.pixel_bytes) : mapping.pixel_bytes;
-      frame.image = cameraBufferToBgr(impl.layout, mapping.pixels, bytes, impl.width, impl.height, impl.stride);
+      CameraImages images =
+          cameraBufferToImages(impl.layout, mapping.pixels, bytes, impl.width, impl.height, impl.stride);
+      frame.image = std::move(images.image);
+      frame.grey = std::move(images.grey);
       impl.requeue(request);
       if (frame.image.empty()) {
         std::lock_guard lock(impl.mutex);

@@ -241,7 +241,12 @@ std::string V4l2FrameSource::describe() const {
   return text.str();
 }
 
-std::int64_t V4l2FrameSource::skippedFrames() const { return status().skipped; }
+// Read every frame by the capture thread: one counter under the lock, not a copy of the whole status
+// (its strings included).
+std::int64_t V4l2FrameSource::skippedFrames() const {
+  std::lock_guard lock(status_mutex_);
+  return status_.skipped;
+}
 
 FrameSourceState V4l2FrameSource::state() const {
   std::lock_guard lock(status_mutex_);
@@ -252,7 +257,10 @@ FrameSourceState V4l2FrameSource::state() const {
   state.dropped = status_.dropped;
   return state;
 }
-std::int64_t V4l2FrameSource::droppedFrames() const { return status().dropped; }
+std::int64_t V4l2FrameSource::droppedFrames() const {
+  std::lock_guard lock(status_mutex_);
+  return status_.dropped;
+}
 
 V4l2SourceStatus V4l2FrameSource::status() const {
   std::lock_guard lock(status_mutex_);
@@ -651,7 +659,9 @@ std::optional<Frame> V4l2FrameSource::handleBuffer(const ::v4l2_buffer& buffer) 
         stream->buffer_returned.notify_all();
       });
     } else {
-      frame.image = cameraBufferToBgr(layout, data, used, width_, height_, bytes_per_line_);
+      CameraImages images = cameraBufferToImages(layout, data, used, width_, height_, bytes_per_line_);
+      frame.image = std::move(images.image);
+      frame.grey = std::move(images.grey);
       if (frame.image.empty()) return skip(&V4l2SourceStatus::decode_failures, "conversion failed");
       requeue(buffer.index);
     }

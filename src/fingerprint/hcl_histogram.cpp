@@ -72,6 +72,41 @@ double HclHistogram::hueLevel(int r, int g, int b) {
   return hueLevelFixed(r, g, b, max, diff, hueStepTable());
 }
 
+namespace {
+
+/// Folds the 256-level hue and 511-level lightness counts into the 13 fuzzy bins, normalised.
+HclHistogramBins foldLevels(const std::array<std::uint32_t, kLevels>& hue,
+                            const std::array<std::uint32_t, 511>& lightness) {
+  // Fold the 256 hue levels into 8 circular bins centred on levels 0, 32, ..., 224: each level votes
+  // for its two nearest centres in proportion to its closeness (triangular membership).
+  std::array<double, kHistogramBins> bins{};
+  for (int level = 0; level < kLevels; ++level) {
+    if (hue[level] == 0) continue;
+    const int lower = level / kLevelsPerHueBin;
+    const double upper_share = static_cast<double>(level % kLevelsPerHueBin) / kLevelsPerHueBin;
+    bins[lower] += hue[level] * (1.0 - upper_share);
+    bins[(lower + 1) % kHueBins] += hue[level] * upper_share;
+  }
+  // Grey: 5 centres on lightness 0, 0.25, 0.5, 0.75, 1 (not circular). Bin order white ... black, so
+  // grey level g (0 = black, 4 = white) goes to bin kHueBins + 4 - g.
+  for (int sum = 0; sum <= 510; ++sum) {
+    if (lightness[sum] == 0) continue;
+    const double position = sum / 127.5;  // 0..4
+    const int lower = std::min(static_cast<int>(position), kGreyBins - 1);
+    const double upper_share = position - lower;
+    bins[kHueBins + (kGreyBins - 1) - lower] += lightness[sum] * (1.0 - upper_share);
+    if (upper_share > 0.0) bins[kHueBins + (kGreyBins - 1) - (lower + 1)] += lightness[sum] * upper_share;
+  }
+  double total = 0.0;
+  for (double v : bins) total += v;
+  HclHistogramBins result{};
+  if (total > 0.0)
+    for (int i = 0; i < kHistogramBins; ++i) result[i] = static_cast<float>(bins[i] / total);
+  return result;
+}
+
+}  // namespace
+
 HclHistogramBins HclHistogram::compute(const cv::Mat& bgr, int column_begin, int column_end) const {
   if (bgr.type() != CV_8UC3) throw std::invalid_argument("HCL histogram: expected an 8-bit BGR image");
   column_begin = std::clamp(column_begin, 0, bgr.cols);
@@ -99,33 +134,27 @@ HclHistogramBins HclHistogram::compute(const cv::Mat& bgr, int column_begin, int
         ++hue[hueLevelFixed(r, g, b, max, diff, step)];
     }
   }
+  return foldLevels(hue, lightness);
+}
 
-  // Fold the 256 hue levels into 8 circular bins centred on levels 0, 32, ..., 224: each level votes
-  // for its two nearest centres in proportion to its closeness (triangular membership).
-  std::array<double, kHistogramBins> bins{};
-  for (int level = 0; level < kLevels; ++level) {
-    if (hue[level] == 0) continue;
-    const int lower = level / kLevelsPerHueBin;
-    const double upper_share = static_cast<double>(level % kLevelsPerHueBin) / kLevelsPerHueBin;
-    bins[lower] += hue[level] * (1.0 - upper_share);
-    bins[(lower + 1) % kHueBins] += hue[level] * upper_share;
+HclHistogramBins HclHistogram::computeGrey(const cv::Mat& grey, int column_begin, int column_end) const {
+  if (grey.type() != CV_8UC1) throw std::invalid_argument("HCL histogram: expected an 8-bit grey image");
+  column_begin = std::clamp(column_begin, 0, grey.cols);
+  column_end = std::clamp(column_end, column_begin, grey.cols);
+  // A grey pixel v is the BGR pixel (v, v, v): chroma 0, so always achromatic, lightness sum 2v. Count
+  // the levels first, then vote, so this equals compute() on the BGR image made from `grey`.
+  std::array<std::uint32_t, kLevels> level{};
+  for (int y = 0; y < grey.rows; ++y) {
+    const std::uint8_t* p = grey.ptr<std::uint8_t>(y);
+    for (int x = column_begin; x < column_end; ++x) ++level[p[x]];
   }
-  // Grey: 5 centres on lightness 0, 0.25, 0.5, 0.75, 1 (not circular). Bin order white ... black, so
-  // grey level g (0 = black, 4 = white) goes to bin kHueBins + 4 - g.
-  for (int sum = 0; sum <= 510; ++sum) {
-    if (lightness[sum] == 0) continue;
-    const double position = sum / 127.5;  // 0..4
-    const int lower = std::min(static_cast<int>(position), kGreyBins - 1);
-    const double upper_share = position - lower;
-    bins[kHueBins + (kGreyBins - 1) - lower] += lightness[sum] * (1.0 - upper_share);
-    if (upper_share > 0.0) bins[kHueBins + (kGreyBins - 1) - (lower + 1)] += lightness[sum] * upper_share;
+  std::array<std::uint32_t, kLevels> hue{};
+  std::array<std::uint32_t, 511> lightness{};
+  for (int v = 0; v < kLevels; ++v) {
+    const int sum = 2 * v;
+    if (sum >= min_lightness_sum_ && sum <= max_lightness_sum_) lightness[sum] = level[v];
   }
-  double total = 0.0;
-  for (double v : bins) total += v;
-  HclHistogramBins result{};
-  if (total > 0.0)
-    for (int i = 0; i < kHistogramBins; ++i) result[i] = static_cast<float>(bins[i] / total);
-  return result;
+  return foldLevels(hue, lightness);
 }
 
 }  // namespace toposlam

@@ -24,10 +24,12 @@ std::string KeypointConfig::validate() const {
   return e.str();
 }
 
-namespace {
+KeypointExtractor::KeypointExtractor(const KeypointConfig& config) : config_(config) {
+  if (std::string problem = config_.validate(); !problem.empty()) throw std::invalid_argument(problem);
+}
 
-// Detectors are cheap to create; one per call keeps extract() safe to call from several threads.
-cv::Ptr<cv::Feature2D> makeDetector(const KeypointConfig& c) {
+cv::Ptr<cv::Feature2D> KeypointExtractor::createDetector() const {
+  const KeypointConfig& c = config_;
   switch (c.backend) {
     case KeypointBackend::Orb:
       return cv::ORB::create(c.candidate_limit, 1.2f, c.orb_levels, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
@@ -43,34 +45,38 @@ cv::Ptr<cv::Feature2D> makeDetector(const KeypointConfig& c) {
   throw std::invalid_argument("unknown keypoint backend");
 }
 
-}  // namespace
-
-KeypointExtractor::KeypointExtractor(const KeypointConfig& config) : config_(config) {
-  if (std::string problem = config_.validate(); !problem.empty()) throw std::invalid_argument(problem);
-}
-
 KeypointCandidates KeypointExtractor::detect(const cv::Mat& grey) const {
   KeypointCandidates out;
   if (config_.max_keypoints == 0) return out;
-  auto detector = makeDetector(config_);
-  detector->detectAndCompute(grey, cv::noArray(), out.keypoints, out.descriptors);
+  detect(*createDetector(), grey, out);
+  return out;
+}
+
+void KeypointExtractor::detect(cv::Feature2D& detector, const cv::Mat& grey, KeypointCandidates& out) const {
+  out.keypoints.clear();
+  if (config_.max_keypoints == 0) {
+    out.descriptors.release();
+    return;
+  }
+  detector.detectAndCompute(grey, cv::noArray(), out.keypoints, out.descriptors);
   if (out.keypoints.size() > static_cast<std::size_t>(config_.candidate_limit)) {
-    // BRISK and AKAZE have no cap of their own: keep the strongest candidates.
+    // BRISK and AKAZE have no cap of their own: keep the strongest candidates, in their order, moving
+    // them forward in place (order is ascending, so a row is only ever copied to a lower one).
     std::vector<int> order(out.keypoints.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(),
                      [&](int a, int b) { return out.keypoints[a].response > out.keypoints[b].response; });
     order.resize(config_.candidate_limit);
     std::sort(order.begin(), order.end());
-    KeypointCandidates capped;
-    capped.descriptors.create(static_cast<int>(order.size()), out.descriptors.cols, out.descriptors.type());
     for (std::size_t r = 0; r < order.size(); ++r) {
-      capped.keypoints.push_back(out.keypoints[order[r]]);
-      out.descriptors.row(order[r]).copyTo(capped.descriptors.row(static_cast<int>(r)));
+      const int from = order[r];
+      if (from == static_cast<int>(r)) continue;
+      out.keypoints[r] = out.keypoints[static_cast<std::size_t>(from)];
+      out.descriptors.row(from).copyTo(out.descriptors.row(static_cast<int>(r)));
     }
-    return capped;
+    out.keypoints.resize(order.size());
+    out.descriptors = out.descriptors.rowRange(0, static_cast<int>(order.size()));
   }
-  return out;
 }
 
 std::vector<int> KeypointExtractor::select(const KeypointCandidates& candidates, int column_begin,

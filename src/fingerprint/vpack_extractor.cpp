@@ -4,6 +4,8 @@
 // Each task writes only its own slot, so the result does not depend on the number of workers.
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 
+#include <cstring>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,14 +33,36 @@ const VpackConfig& validated(const VpackConfig& config) {
 }
 }  // namespace
 
+/// What one extraction works in, kept between frames: frames of one size reuse the same memory and
+/// the detector is made once. One extraction at a time uses it; a concurrent one makes its own.
+struct VpackExtractor::Scratch {
+  std::mutex busy;
+  cv::Mat grey;  ///< the frame's grey when it has to be converted
+  cv::Mat bgr;   ///< a BGRA frame without its alpha
+  cv::Ptr<cv::Feature2D> detector;
+  VerticalEdgeScratch edge_scratch;
+  VerticalEdges edges;
+  KeypointCandidates candidates;
+  std::vector<std::vector<int>> selected;  ///< per subregion, indices into candidates
+};
+
 VpackExtractor::VpackExtractor(const VpackConfig& config, WorkerPool* pool)
     : config_(validated(config)),
       pool_(pool),
       edge_detector_(config.edges),
       histogram_(config.histogram),
-      keypoints_(config.keypoints) {}
+      keypoints_(config.keypoints),
+      scratch_(std::make_unique<Scratch>()) {}
+
+VpackExtractor::~VpackExtractor() = default;
+VpackExtractor::VpackExtractor(VpackExtractor&&) noexcept = default;
 
 Fingerprint VpackExtractor::extract(const cv::Mat& image, VpackDiagnostics* diagnostics) const {
+  return extract(image, cv::Mat(), diagnostics);
+}
+
+Fingerprint VpackExtractor::extract(const cv::Mat& image, const cv::Mat& luma,
+                                    VpackDiagnostics* diagnostics) const {
   if (image.empty()) throw std::invalid_argument("cannot fingerprint an empty image");
   if (image.depth() != CV_8U)
     throw std::invalid_argument("cannot fingerprint an image with " + std::to_string(image.elemSize1() * 8) +
@@ -49,19 +73,36 @@ Fingerprint VpackExtractor::extract(const cv::Mat& image, VpackDiagnostics* diag
       << config_.min_image_width << "x" << config_.min_image_height;
     throw std::invalid_argument(e.str());
   }
-  cv::Mat bgr, grey;
+  if (!luma.empty() && (luma.type() != CV_8UC1 || luma.size() != image.size()))
+    throw std::invalid_argument(
+        "the grey plane given with a frame must be 8-bit, one channel, of the frame's size");
+
+  // The shared scratch when free; a concurrent extraction works in its own.
+  std::unique_lock<std::mutex> lock(scratch_->busy, std::try_to_lock);
+  std::unique_ptr<Scratch> own;
+  Scratch* scratch = scratch_.get();
+  if (!lock.owns_lock()) {
+    own = std::make_unique<Scratch>();
+    scratch = own.get();
+  }
+
+  // Colour only feeds the histograms; edges and keypoints want grey, taken as it came when it did.
+  cv::Mat colour, grey;
   switch (image.channels()) {
     case 1:
       grey = image;
-      cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+      colour = image;  // histograms in the grey bins, straight from the grey pixels
       break;
     case 3:
-      bgr = image;
-      cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+      colour = image;
+      if (luma.empty()) cv::cvtColor(image, scratch->grey, cv::COLOR_BGR2GRAY);
+      grey = luma.empty() ? scratch->grey : luma;
       break;
     case 4:
-      cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
-      cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+      cv::cvtColor(image, scratch->bgr, cv::COLOR_BGRA2BGR);
+      colour = scratch->bgr;
+      if (luma.empty()) cv::cvtColor(image, scratch->grey, cv::COLOR_BGRA2GRAY);
+      grey = luma.empty() ? scratch->grey : luma;
       break;
     default:
       throw std::invalid_argument("cannot fingerprint an image with " + std::to_string(image.channels()) +
@@ -73,10 +114,12 @@ Fingerprint VpackExtractor::extract(const cv::Mat& image, VpackDiagnostics* diag
   fingerprint.image_height = image.rows;
   fingerprint.backend = keypoints_.backend();
 
-  VerticalEdges edges = edge_detector_.detect(grey);
+  VerticalEdges& edges = scratch->edges;
+  edge_detector_.detect(grey, edges, scratch->edge_scratch);
   // An edge on the first or last column would leave an empty subregion.
   for (int column : edges.columns)
     if (column > 0 && column < image.cols) fingerprint.edge_columns.push_back(column);
+  fingerprint.subregions.reserve(fingerprint.edge_columns.size() + 1);
   int begin = 0;
   for (int column : fingerprint.edge_columns) {
     fingerprint.subregions.push_back({begin, column, {}, 0, 0});
@@ -86,18 +129,28 @@ Fingerprint VpackExtractor::extract(const cv::Mat& image, VpackDiagnostics* diag
   const std::size_t regions = fingerprint.subregions.size();
 
   // Phase A: task 0 detects keypoint candidates, tasks 1..n compute the histograms.
-  KeypointCandidates candidates;
+  KeypointCandidates& candidates = scratch->candidates;
+  if (config_.keypoints.max_keypoints > 0 && scratch->detector.empty())
+    scratch->detector = keypoints_.createDetector();
+  const bool grey_colour = colour.channels() == 1;
   auto phase_a = [&](std::size_t task) {
     if (task == 0) {
-      candidates = keypoints_.detect(grey);
+      if (scratch->detector.empty()) {
+        candidates.keypoints.clear();
+        candidates.descriptors.release();
+      } else {
+        keypoints_.detect(*scratch->detector, grey, candidates);
+      }
     } else {
       Subregion& s = fingerprint.subregions[task - 1];
-      s.histogram = histogram_.compute(bgr, s.column_begin, s.column_end);
+      s.histogram = grey_colour ? histogram_.computeGrey(colour, s.column_begin, s.column_end)
+                                : histogram_.compute(colour, s.column_begin, s.column_end);
     }
   };
   // Phase B: each subregion keeps its share of the candidates.
   const std::vector<int> budgets = keypoints_.budgets(fingerprint.subregions, image.cols);
-  std::vector<std::vector<int>> selected(regions);
+  std::vector<std::vector<int>>& selected = scratch->selected;
+  if (selected.size() < regions) selected.resize(regions);
   auto phase_b = [&](std::size_t i) {
     const Subregion& s = fingerprint.subregions[i];
     selected[i] = keypoints_.select(candidates, s.column_begin, s.column_end, budgets[i]);
@@ -110,26 +163,29 @@ Fingerprint VpackExtractor::extract(const cv::Mat& image, VpackDiagnostics* diag
     for (std::size_t t = 0; t < regions; ++t) phase_b(t);
   }
 
+  // The kept candidates, copied once, straight into the fingerprint's own rows.
   std::size_t total = 0;
-  for (const auto& s : selected) total += s.size();
+  for (std::size_t i = 0; i < regions; ++i) total += selected[i].size();
   fingerprint.keypoints.reserve(total);
   if (total > 0)
     fingerprint.descriptors.create(static_cast<int>(total), candidates.descriptors.cols,
                                    candidates.descriptors.type());
+  const std::size_t row_bytes =
+      total > 0 ? fingerprint.descriptors.cols * fingerprint.descriptors.elemSize() : 0;
   int row = 0;
   for (std::size_t i = 0; i < regions; ++i) {
     Subregion& s = fingerprint.subregions[i];
     s.keypoint_begin = row;
     for (int index : selected[i]) {
-      cv::KeyPoint k = candidates.keypoints[index];
+      cv::KeyPoint k = candidates.keypoints[static_cast<std::size_t>(index)];
       k.class_id = static_cast<int>(i);
       fingerprint.keypoints.push_back(k);
-      candidates.descriptors.row(index).copyTo(fingerprint.descriptors.row(row));
+      std::memcpy(fingerprint.descriptors.ptr(row), candidates.descriptors.ptr(index), row_bytes);
       ++row;
     }
     s.keypoint_end = row;
   }
-  if (diagnostics != nullptr) diagnostics->edges = std::move(edges);
+  if (diagnostics != nullptr) diagnostics->edges = edges;
   return fingerprint;
 }
 

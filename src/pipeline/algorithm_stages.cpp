@@ -13,9 +13,13 @@
 namespace toposlam {
 
 FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
-                                                   const SimilarityMeasure& similarity, std::size_t max_thumbnails,
-                                                   const MotionGateConfig& motion)
-    : segmenter_(config, similarity), max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)), gate_(motion) {}
+                                                   const SimilarityMeasure& similarity,
+                                                   std::size_t max_thumbnails, const MotionGateConfig& motion)
+    : segmenter_(config, similarity),
+      max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)),
+      gate_(motion) {
+  thumbnails_.reserve(max_thumbnails_ + 1);
+}
 
 void FiedlerSegmentationStage::addMotion(const MotionSample& sample) {
   const std::lock_guard<std::mutex> lock(motion_mutex_);
@@ -51,8 +55,15 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
                    gate_.config().timeout_s);
     }
   }
-  thumbnails_.emplace(sequence, thumbnail);
-  if (thumbnails_.size() > max_thumbnails_) thumbnails_.erase(thumbnails_.begin());
+  // Kept as a map from frame to thumbnail would be (a frame seen twice keeps its first thumbnail; beyond
+  // max_thumbnails_ the lowest frame goes), in a vector reserved once.
+  auto same_frame = [&](const auto& entry) { return entry.first == sequence; };
+  if (std::none_of(thumbnails_.begin(), thumbnails_.end(), same_frame)) {
+    thumbnails_.emplace_back(sequence, thumbnail);
+    if (thumbnails_.size() > max_thumbnails_)
+      thumbnails_.erase(std::min_element(thumbnails_.begin(), thumbnails_.end(),
+                                         [](const auto& a, const auto& b) { return a.first < b.first; }));
+  }
   // The window's clock is the frame's source time (a window in seconds of the world, also when a file or
   // the simulator plays faster than real time); motion is looked up at the pipeline clock, the clock of
   // motion_t.utime. A source time that does not increase (a source without timestamps) falls back to
@@ -91,11 +102,13 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
     place.representative_frame = p.representative_frame;
     place.keypoints = p.representative_keypoints;
     place.representative = p.representative;
-    if (auto it = thumbnails_.find(p.representative_frame); it != thumbnails_.end()) place.thumbnail = it->second;
+    const auto it = std::find_if(thumbnails_.begin(), thumbnails_.end(),
+                                 [&](const auto& entry) { return entry.first == p.representative_frame; });
+    if (it != thumbnails_.end()) place.thumbnail = it->second;
     out = std::move(place);
   }
   // Frames up to the closed place's end are no longer needed.
-  thumbnails_.erase(thumbnails_.begin(), thumbnails_.upper_bound(p.last_frame));
+  std::erase_if(thumbnails_, [&](const auto& entry) { return entry.first <= p.last_frame; });
   return out;
 }
 

@@ -271,7 +271,8 @@ void Pipeline::fingerprintLoop() {
       const double t0 = clock_.now();
       Fingerprinted out;
       try {
-        out.fingerprint = std::make_shared<const Fingerprint>(fingerprint_.process(captured.frame.image));
+        out.fingerprint = std::make_shared<const Fingerprint>(
+            fingerprint_.process(captured.frame.image, captured.frame.grey));
         const cv::Mat& image = captured.frame.image;
         const int width = std::min(config_.thumbnail_width, image.cols);
         const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));

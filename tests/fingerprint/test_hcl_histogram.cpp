@@ -2,6 +2,8 @@
 #include <numeric>
 #include <random>
 
+#include <opencv2/imgproc.hpp>
+
 #include <catch2/catch.hpp>
 
 #include "toposlam/fingerprint/hcl_histogram.hpp"
@@ -110,4 +112,26 @@ TEST_CASE("GIVEN hue levels WHEN computed for primaries THEN they sit on the 256
   CHECK(HclHistogram::hueLevel(255, 0, 0) == 0.0);
   CHECK(HclHistogram::hueLevel(0, 255, 0) == 85.0);
   CHECK(HclHistogram::hueLevel(0, 0, 255) == 171.0);
+}
+
+TEST_CASE(
+    "GIVEN a grey image WHEN histogrammed from its grey pixels THEN the bins equal those of its BGR copy") {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> level(0, 255);
+  cv::Mat grey(37, 53, CV_8UC1), bgr;
+  for (int y = 0; y < grey.rows; ++y)
+    for (int x = 0; x < grey.cols; ++x) grey.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(level(rng));
+  cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+  HclHistogramConfig apexes_dropped;
+  apexes_dropped.min_lightness = 0.1;
+  apexes_dropped.max_lightness = 0.8;
+  for (const HclHistogramConfig& config : {HclHistogramConfig{}, apexes_dropped}) {
+    const HclHistogram histogram(config);
+    for (auto [begin, end] :
+         {std::pair{0, 53}, std::pair{5, 6}, std::pair{10, 40}, std::pair{-3, 99}, std::pair{20, 20}}) {
+      INFO("columns " << begin << " .. " << end << ", lightness from " << config.min_lightness);
+      CHECK(histogram.computeGrey(grey, begin, end) == histogram.compute(bgr, begin, end));  // exactly
+    }
+  }
+  CHECK_THROWS_WITH(HclHistogram().computeGrey(bgr, 0, 1), Catch::Contains("8-bit grey"));
 }

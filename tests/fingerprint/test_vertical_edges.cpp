@@ -1,4 +1,6 @@
 // Vertical edge detection (thesis 3.2.1) and the 1-D NMS of Algorithm 3.1.
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <catch2/catch.hpp>
@@ -128,4 +130,68 @@ TEST_CASE("GIVEN bad edge configs WHEN validated THEN the key is named") {
   VerticalEdgeConfig d;
   d.opening_height_fraction = 0;
   CHECK_THAT(d.validate(), Catch::Contains("opening_height_fraction"));
+}
+
+namespace {
+
+// Steps 1-4 as OpenCV's filters compute them (the detector's code before issue 18), normalised.
+std::vector<float> openCvColumnResponse(const cv::Mat& grey, const toposlam::VerticalEdgeConfig& config) {
+  cv::Mat gradient, magnitude, dilated, opened, sums;
+  cv::Sobel(grey, gradient, CV_16S, 1, 0, 3);
+  cv::convertScaleAbs(gradient, magnitude);
+  cv::dilate(magnitude, dilated,
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(config.dilation_width, 1)));
+  const int opening =
+      std::clamp(static_cast<int>(std::lround(config.opening_height_fraction * grey.rows)), 1, grey.rows);
+  cv::morphologyEx(dilated, opened, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(1, opening)));
+  cv::reduce(opened, sums, 0, cv::REDUCE_SUM, CV_32F);
+  std::vector<float> response(sums.ptr<float>(0), sums.ptr<float>(0) + grey.cols);
+  float peak = 0.f;
+  for (float v : response) peak = std::max(peak, v);
+  if (peak <= 0.f) return response;
+  for (float& v : response) v /= peak;
+  return response;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "GIVEN images of any size and edge configs WHEN the column response is computed THEN it equals "
+    "OpenCV's Sobel, dilation, opening and column sum to the bit") {
+  std::mt19937 rng(18);
+  std::vector<cv::Mat> images;
+  for (cv::Size size : {cv::Size(1, 1), cv::Size(2, 2), cv::Size(3, 5), cv::Size(17, 16), cv::Size(64, 7),
+                        cv::Size(101, 99)}) {
+    cv::Mat noise(size, CV_8UC1);
+    cv::randu(noise, 0, 256);
+    images.push_back(noise);
+    cv::Mat bars(size, CV_8UC1, cv::Scalar(200));  // long vertical structure, and short pieces
+    for (int x = 1; x < size.width; x += 7) bars.col(x).setTo(20);
+    for (int y = 0; y < size.height; y += 5) bars(cv::Rect(0, y, size.width, 1)).setTo(90);
+    images.push_back(bars);
+  }
+  for (int i : {1, 44, 84}) {
+    cv::Mat grey;
+    cv::cvtColor(toposlam::test::sampleFrame(i), grey, cv::COLOR_BGR2GRAY);
+    images.push_back(grey);
+    // Views: neighbours beyond the view come from the frame; one view reaches the frame's own border.
+    images.push_back(grey(cv::Rect(13, 7, 301, 250)));
+    images.push_back(grey(cv::Rect(grey.cols - 120, grey.rows - 90, 120, 90)));
+  }
+  for (int width : {1, 2, 3, 4, 7}) {
+    for (double fraction : {0.01, 0.2, 0.37, 1.0}) {
+      toposlam::VerticalEdgeConfig config;
+      config.dilation_width = width;
+      config.opening_height_fraction = fraction;
+      const toposlam::VerticalEdgeDetector detector(config);
+      toposlam::VerticalEdgeScratch scratch;  // shared by every image: sizes change under it
+      toposlam::VerticalEdges edges;
+      for (const cv::Mat& image : images) {
+        INFO(image.cols << "x" << image.rows << ", dilation " << width << ", opening " << fraction);
+        detector.detect(image, edges, scratch);
+        CHECK(edges.column_response == openCvColumnResponse(image, config));
+      }
+    }
+  }
 }

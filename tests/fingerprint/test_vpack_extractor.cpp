@@ -1,6 +1,8 @@
 // VPACK extraction end to end on real sample frames: keypoint budget, worker independence,
 // serialisation round trip, bad input.
+#include <atomic>
 #include <sstream>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -146,4 +148,76 @@ TEST_CASE("GIVEN an invalid fingerprint config WHEN the extractor is built THEN 
   config.keypoints.max_keypoints = -1;
   CHECK_THROWS_WITH(VpackExtractor(config), Catch::Contains("fingerprint.keypoints.max_keypoints"));
   CHECK_THROWS_WITH(parseKeypointBackend("surf"), Catch::Contains("allowed: orb, sift, brisk, akaze"));
+}
+
+TEST_CASE(
+    "GIVEN one extractor WHEN frames of changing size and kind follow each other THEN each equals a fresh "
+    "extractor's") {
+  // The extractor keeps its working images and detector between frames: no frame may see another's.
+  for (KeypointBackend backend : {KeypointBackend::Orb, KeypointBackend::Brisk}) {
+    VpackConfig config;
+    config.keypoints.backend = backend;
+    WorkerPool two(2);
+    VpackExtractor reused(config, &two);
+    for (int i : {5, 40, 5, 77}) {
+      cv::Mat colour = test::sampleFrame(i), small, grey, bgra;
+      cv::resize(colour, small, cv::Size(320, 240), 0, 0, cv::INTER_AREA);
+      cv::cvtColor(small, grey, cv::COLOR_BGR2GRAY);
+      cv::cvtColor(colour, bgra, cv::COLOR_BGR2BGRA);
+      for (const cv::Mat& image : {colour, small, grey, bgra, colour}) {
+        INFO(toString(backend) << " frame " << i << ", " << image.cols << "x" << image.rows << "x"
+                               << image.channels());
+        CHECK(reused.extract(image).equals(VpackExtractor(config).extract(image)));
+      }
+    }
+  }
+}
+
+TEST_CASE(
+    "GIVEN one extractor WHEN two threads fingerprint at once THEN both get the single-threaded "
+    "fingerprints") {
+  const VpackExtractor extractor;
+  std::vector<cv::Mat> frames;
+  std::vector<Fingerprint> expected;
+  for (int i : {2, 21, 48, 80}) {
+    frames.push_back(test::sampleFrame(i));
+    expected.push_back(VpackExtractor().extract(frames.back()));
+  }
+  std::atomic<int> mismatches{0};
+  auto work = [&] {
+    for (int pass = 0; pass < 5; ++pass)
+      for (std::size_t k = 0; k < frames.size(); ++k)
+        if (!extractor.extract(frames[k]).equals(expected[k])) mismatches.fetch_add(1);
+  };
+  std::thread other(work);
+  work();
+  other.join();
+  CHECK(mismatches.load() == 0);
+}
+
+TEST_CASE(
+    "GIVEN a frame with its grey given WHEN fingerprinted THEN edges and keypoints come from that grey") {
+  const cv::Mat colour = test::sampleFrame(12);
+  cv::Mat grey;
+  cv::cvtColor(colour, grey, cv::COLOR_BGR2GRAY);
+  const VpackExtractor extractor;
+  const Fingerprint converted = extractor.extract(colour);
+  THEN("the grey the extractor would have made gives the same fingerprint, to the bit") {
+    CHECK(extractor.extract(colour, grey).equals(converted));
+    CHECK(extractor.extract(colour, cv::Mat()).equals(converted));
+  }
+  THEN("another grey (flipped) changes edges and keypoints but not what colour decides") {
+    cv::Mat flipped;
+    cv::flip(grey, flipped, 1);
+    const Fingerprint f = extractor.extract(colour, flipped);
+    const Fingerprint from_flipped = extractor.extract(flipped);
+    CHECK(f.edge_columns == from_flipped.edge_columns);
+    CHECK(f.keypointCount() == from_flipped.keypointCount());
+    CHECK(f.subregions.size() == from_flipped.subregions.size());
+    CHECK_FALSE(f.equals(converted));
+  }
+  THEN("a grey of the wrong size or type is refused") {
+    CHECK_THROWS_WITH(extractor.extract(colour, cv::Mat(10, 10, CV_8UC1)), Catch::Contains("grey plane"));
+    CHECK_THROWS_WITH(extractor.extract(colour, colour), Catch::Contains("grey plane"));
+  }
 }

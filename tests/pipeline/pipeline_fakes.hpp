@@ -109,7 +109,7 @@ class AbsentCameraSource final : public FrameSource {
 
 class FakeFingerprint final : public FingerprintStage {
  public:
-  Fingerprint process(const cv::Mat& image) override {
+  Fingerprint process(const cv::Mat& image, const cv::Mat& /*grey*/) override {
     const int value = image.at<cv::Vec3b>(0, 0)[0];
     if (on_process) on_process(value);
     if (throw_when && throw_when(value)) throw std::invalid_argument("unreadable frame");
@@ -195,7 +195,7 @@ class FakeTopology final : public TopologyStage {
     return std::nullopt;
   }
   bool idle() const override { return queue_.empty(); }
-  PlaceEstimate estimate() const override { return estimate_; }
+  const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override {
     TopologySnapshot t;
     t.map_revision = revision_;

@@ -1,10 +1,12 @@
-// cameraBufferToBgr: every layout the camera backends receive becomes the right BGR pixels, strides are
-// honoured, and short or undecodable buffers give an empty image (which the backends count as skipped).
+// cameraBufferToBgr and cameraBufferToImages: every layout the camera backends receive becomes the right BGR
+// pixels, strides are honoured, and short or undecodable buffers give an empty image (which the backends
+// count as skipped).
 #include <catch2/catch.hpp>
 
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "camera_pixels.hpp"
 
@@ -58,4 +60,67 @@ SCENARIO("GIVEN JPEG buffers WHEN converted THEN a valid one decodes and garbage
   const std::vector<std::uint8_t> garbage(64, 0x5a);
   CHECK(cameraBufferToBgr(CameraPixelLayout::Jpeg, garbage.data(), garbage.size(), 0, 0, 0).empty());
   CHECK(cameraBufferToBgr(CameraPixelLayout::Jpeg, jpeg.data(), 0, 0, 0, 0).empty());
+}
+
+SCENARIO(
+    "GIVEN camera buffers WHEN made into a frame's images THEN grey stays grey and YUYV brings its luma") {
+  using toposlam::cameraBufferToImages;
+  using toposlam::CameraImages;
+  GIVEN("a grey camera's 2x2 buffer with a padded stride") {
+    const std::vector<std::uint8_t> grey = {0, 255, 9, 9, 128, 64};
+    const CameraImages images =
+        cameraBufferToImages(CameraPixelLayout::Grey, grey.data(), grey.size(), 2, 2, 4);
+    THEN("the image is the grey pixels, copied, never BGR, and it is its own grey") {
+      REQUIRE(images.image.type() == CV_8UC1);
+      CHECK(images.image.at<std::uint8_t>(0, 1) == 255);
+      CHECK(images.image.at<std::uint8_t>(1, 0) == 128);
+      CHECK(images.image.at<std::uint8_t>(1, 1) == 64);
+      CHECK(images.image.data != grey.data());
+      CHECK(images.grey.data == images.image.data);
+      CHECK(cameraBufferToImages(CameraPixelLayout::Grey, grey.data(), 5, 2, 2, 4).image.empty());
+    }
+  }
+  GIVEN("a YUYV buffer of every luma level, neutral and coloured chroma") {
+    // 256 x 3 pixels: row 0 neutral (U = V = 128), rows 1 and 2 moderately coloured.
+    const int width = 256, height = 3;
+    std::vector<std::uint8_t> yuyv(static_cast<std::size_t>(width * height * 2));
+    const int chroma[3][2] = {{128, 128}, {100, 150}, {150, 110}};
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::size_t at = static_cast<std::size_t>((y * width + x) * 2);
+        yuyv[at] = static_cast<std::uint8_t>(x);
+        yuyv[at + 1] = static_cast<std::uint8_t>(chroma[y][x % 2]);
+      }
+    const CameraImages images =
+        cameraBufferToImages(CameraPixelLayout::Yuyv, yuyv.data(), yuyv.size(), width, height, width * 2);
+    cv::Mat bgr =
+        cameraBufferToBgr(CameraPixelLayout::Yuyv, yuyv.data(), yuyv.size(), width, height, width * 2);
+    cv::Mat round_trip;
+    cv::cvtColor(bgr, round_trip, cv::COLOR_BGR2GRAY);
+    THEN("the image is the same BGR and the luma is the round trip's grey where the chroma is neutral") {
+      CHECK(cv::norm(images.image, bgr, cv::NORM_INF) == 0);
+      REQUIRE(images.grey.type() == CV_8UC1);
+      CHECK(cv::norm(images.grey.row(0), round_trip.row(0), cv::NORM_INF) == 0);
+      for (int level = 0; level < 256; ++level)  // the table, and the arithmetic that stands for it
+        CHECK(images.grey.at<std::uint8_t>(0, level) ==
+              toposlam::yuyvLumaToGrey()[static_cast<std::size_t>(level)]);
+      CHECK(images.grey.at<std::uint8_t>(0, 16) == 0);     // video black
+      CHECK(images.grey.at<std::uint8_t>(0, 235) == 255);  // video white
+    }
+    THEN("where it is coloured, only the decoder's clipping and rounding separate them") {
+      // Measured: away from clipping (luma 60..179) one rounding step at most; near black and white,
+      // where the decoder clips a channel, up to 11 levels.
+      CHECK(cv::norm(images.grey(cv::Rect(60, 1, 120, 2)), round_trip(cv::Rect(60, 1, 120, 2)),
+                     cv::NORM_INF) == 1);
+      CHECK(cv::norm(images.grey.rowRange(1, 3), round_trip.rowRange(1, 3), cv::NORM_INF) == 11);
+    }
+  }
+  GIVEN("BGR, RGB or JPEG buffers") {
+    const std::vector<std::uint8_t> rgb = {10, 20, 30, 40, 50, 60, 0, 0, 70, 80, 90, 100, 110, 120};
+    const CameraImages images = cameraBufferToImages(CameraPixelLayout::Rgb, rgb.data(), rgb.size(), 2, 2, 8);
+    THEN("they carry no grey of their own") {
+      CHECK(images.image.type() == CV_8UC3);
+      CHECK(images.grey.empty());
+    }
+  }
 }

@@ -26,6 +26,9 @@ class HclHistogram {
   explicit HclHistogram(const HclHistogramConfig& config = {});
   /// bgr: CV_8UC3 image (OpenCV's BGR order); the histogram of the columns [column_begin, column_end).
   HclHistogramBins compute(const cv::Mat& bgr, int column_begin, int column_end) const;
+  /// grey: CV_8UC1 image; equals compute() on the BGR image whose three channels are `grey`, without
+  /// making it (a grey camera's frames are never turned into colour).
+  HclHistogramBins computeGrey(const cv::Mat& grey, int column_begin, int column_end) const;
   /// Hue of one pixel on the 256-level scale (0 = red, 85.3 = green, 170.7 = blue).
   static double hueLevel(int r, int g, int b);
 

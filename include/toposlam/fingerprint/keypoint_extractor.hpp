@@ -46,8 +46,13 @@ class KeypointExtractor {
   KeypointBackend backend() const { return config_.backend; }
   const KeypointConfig& config() const { return config_; }
 
-  /// Detects and describes candidates over the whole grey frame (CV_8UC1).
+  /// A detector for this config. Reused from frame to frame by one caller at a time (OpenCV's
+  /// detectors are not documented as safe to share between threads).
+  cv::Ptr<cv::Feature2D> createDetector() const;
+  /// Detects and describes candidates over the whole grey frame (CV_8UC1), with a detector of its own.
   KeypointCandidates detect(const cv::Mat& grey) const;
+  /// The same with `detector` (from createDetector()), into `out`, whose storage is reused.
+  void detect(cv::Feature2D& detector, const cv::Mat& grey, KeypointCandidates& out) const;
   /// Indices into `candidates` of the keypoints the subregion [column_begin, column_end) keeps,
   /// at most `budget` unless the threshold iterations could not get there; strongest first.
   std::vector<int> select(const KeypointCandidates& candidates, int column_begin, int column_end,
@@ -57,7 +62,6 @@ class KeypointExtractor {
 
  private:
   KeypointConfig config_;
-  cv::Ptr<cv::Feature2D> detector_;
 };
 
 }  // namespace toposlam

@@ -4,6 +4,7 @@
 // minimum separation of 5 % of the width. n edges split the frame into n+1 ordered subregions.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -26,13 +27,29 @@ struct VerticalEdges {
   std::vector<int> columns;            ///< edge columns, ascending
 };
 
+/// The working memory of one detection. Kept by a caller that detects frame after frame, so frames of
+/// one size need no new memory; used by one detection at a time.
+struct VerticalEdgeScratch {
+  std::vector<std::uint8_t> magnitude;        ///< one row of |Sobel x|
+  std::vector<std::uint8_t> dilated, eroded;  ///< height x width
+  std::vector<std::uint8_t> prefix, suffix;   ///< the opening's running extrema, (height + k - 1) x width
+  std::vector<std::uint8_t> identity_row;     ///< rows outside the image
+  std::vector<std::uint32_t> sums;            ///< column sums of the opened image
+  std::vector<float> kept;                    ///< the column response above the threshold
+};
+
 class VerticalEdgeDetector {
  public:
   explicit VerticalEdgeDetector(const VerticalEdgeConfig& config = {});
   /// grey: CV_8UC1 image. Throws std::invalid_argument on an empty or non-8-bit-grey image.
   VerticalEdges detect(const cv::Mat& grey) const;
+  /// The same into `result`, working in `scratch` (both reused from frame to frame).
+  void detect(const cv::Mat& grey, VerticalEdges& result, VerticalEdgeScratch& scratch) const;
 
  private:
+  /// Steps 1-4 into scratch.sums.
+  void columnResponse(const cv::Mat& grey, VerticalEdgeScratch& scratch) const;
+
   VerticalEdgeConfig config_;
 };
 

@@ -3,6 +3,7 @@
 // WorkerPool handed to the extractor (none = inline); results are identical for any pool size.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -34,10 +35,19 @@ class VpackExtractor {
  public:
   /// Throws std::invalid_argument naming the bad key when the config is invalid.
   explicit VpackExtractor(const VpackConfig& config = {}, WorkerPool* pool = nullptr);
+  ~VpackExtractor();
+  VpackExtractor(VpackExtractor&&) noexcept;
 
   /// image: CV_8UC3 (BGR), CV_8UC4 (BGRA) or CV_8UC1 (grey, histograms then fall in grey bins).
   /// Throws std::invalid_argument with a clear message for empty, too small or unsupported images.
+  /// Thread-safe. Working images and the keypoint detector are kept between calls, so a stream of
+  /// frames of one size reuses them; a call made while another is running works in memory of its own.
   Fingerprint extract(const cv::Mat& image, VpackDiagnostics* diagnostics = nullptr) const;
+  /// The same, with the frame's grey given (`luma`: CV_8UC1, the image's size; a YUYV camera's Y
+  /// plane) for edges and keypoints instead of converting `image`, which then only feeds the colour
+  /// histograms. An empty `luma` means: convert, as above.
+  Fingerprint extract(const cv::Mat& image, const cv::Mat& luma,
+                      VpackDiagnostics* diagnostics = nullptr) const;
 
   const VpackConfig& config() const { return config_; }
 
@@ -47,6 +57,8 @@ class VpackExtractor {
   VerticalEdgeDetector edge_detector_;
   HclHistogram histogram_;
   KeypointExtractor keypoints_;
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;  ///< never null (moved-from extractors aside)
 };
 
 /// Draws edges (red lines), subregion borders and keypoints on a copy of the image (Figure 3.11).

@@ -20,7 +20,11 @@
 namespace toposlam {
 
 struct Frame {
-  cv::Mat image;                  ///< CV_8UC3, BGR. May view a driver buffer held by `buffer_lease`.
+  cv::Mat image;  ///< CV_8UC3, BGR (CV_8UC1 from a grey camera). May view a driver
+                  ///< buffer held by `buffer_lease`.
+  /// The camera's own grey when it has one (a YUYV camera's luma; a grey camera's `image`), used for
+  /// edges and keypoints instead of converting `image`; empty: convert.
+  cv::Mat grey;
   std::int64_t sequence = 0;      ///< frame number from the source, from 0; gaps mean dropped frames
   double timestamp_s = 0.0;       ///< capture time in seconds (source clock: monotonic or recorded)
   std::string name;               ///< e.g. the file name, for reports; may be empty

@@ -5,12 +5,12 @@
 
 #include <cstdint>
 #include <deque>
-#include <map>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -28,7 +28,9 @@ class WorkerPool;
 class VpackFingerprintStage final : public FingerprintStage {
  public:
   VpackFingerprintStage(const VpackConfig& config, WorkerPool* pool) : extractor_(config, pool) {}
-  Fingerprint process(const cv::Mat& image) override { return extractor_.extract(image); }
+  Fingerprint process(const cv::Mat& image, const cv::Mat& grey) override {
+    return extractor_.extract(image, grey);
+  }
 
  private:
   VpackExtractor extractor_;
@@ -79,7 +81,9 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 
   FiedlerSegmenter segmenter_;
   std::size_t max_thumbnails_;
-  std::map<std::int64_t, cv::Mat> thumbnails_;  ///< frame -> thumbnail, frames of the open place
+  /// (frame, thumbnail) of the open place's frames, in arrival order; capacity max_thumbnails_ reserved
+  /// once, so a frame costs no node allocation.
+  std::vector<std::pair<std::int64_t, cv::Mat>> thumbnails_;
   std::int64_t dropped_places_ = 0;
 
   MotionGate gate_;
@@ -112,7 +116,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   void enqueuePlace(const ClosedPlace& place) override;
   std::optional<PlaceAssignment> advance(double budget_s) override;
   bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
-  PlaceEstimate estimate() const override { return estimate_; }
+  const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override { return topology_; }
   std::unique_ptr<const MapSnapshot> snapshotMap() const override;
 

@@ -90,7 +90,8 @@ struct TopologySnapshot {
 class FingerprintStage {
  public:
   virtual ~FingerprintStage() = default;
-  virtual Fingerprint process(const cv::Mat& image) = 0;
+  /// image: the frame (BGR, or grey); grey: the camera's own grey of it, or empty (Frame::grey).
+  virtual Fingerprint process(const cv::Mat& image, const cv::Mat& grey) = 0;
 };
 
 /// Fingerprint -> Fiedler value and, now and then, a closed place. Called for every frame, in order.
@@ -132,8 +133,9 @@ class TopologyStage {
   virtual std::optional<PlaceAssignment> advance(double budget_s) = 0;
   /// True when no step is queued or in progress.
   virtual bool idle() const = 0;
-  /// The estimate as of the last finished step.
-  virtual PlaceEstimate estimate() const = 0;
+  /// The estimate as of the last finished step (valid until the next advance() or map load; read on
+  /// the frame path, so not a copy).
+  virtual const PlaceEstimate& estimate() const = 0;
   /// The most probable topology as of the last finished step.
   virtual TopologySnapshot topology() const = 0;
   /// The map as it is now, to be written by MapSnapshot::writeTo() from any thread. Only called when
