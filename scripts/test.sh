@@ -35,4 +35,9 @@ if [ "${CI:-}" = "true" ] || [ "${TOPOSLAM_SANITIZERS:-0}" = "1" ]; then
   TSAN_OPTIONS=halt_on_error=1 ctest --test-dir "$root/build-tsan" --output-on-failure -j "$jobs" \
     -E "_NOT_BUILT|^fuzz_replay_|^firmware-host-wheel-link-encoder$|^test_platform_udpm_reader$" \
     -LE "slow|vm|browser|e2e|cli" ${CTEST_ARGS:-}
+
+  echo "== libFuzzer targets, ${FUZZ_SECONDS:-20} s each (scripts/fuzz.sh; tests/fuzz/)"
+  # A fourth build (clang, ASan + UBSan, coverage): about 6 min with a warm ccache on 2 cores under load,
+  # then each target from its checked-in corpus. A crash fails CI; copy it into the corpus once fixed.
+  SECONDS_PER_TARGET="${FUZZ_SECONDS:-20}" BUILD_DIR="$root/build-fuzz" scripts/fuzz.sh
 fi

@@ -357,13 +357,14 @@ void Pipeline::saveMap(bool final) {
 }
 
 void Pipeline::mapWriterLoop() {
-  // Writes snapshots with their fsync here, so a slow disk never holds up the topology thread.
+  // Encodes and writes snapshots with their fsync here, so neither a big map nor a slow disk holds up the
+  // topology thread.
   while (std::optional<MapWrite> job = map_writes_->pop()) {
     const double t0 = clock_.now();
     try {
       job->snapshot->writeTo(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
       maps_saved_.fetch_add(1);
-      spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, write {:.2f} ms "
+      spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, encode and write {:.2f} ms "
                    "in the map writer)",
                    config_.map_path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
     } catch (const std::exception& e) {
