@@ -24,10 +24,15 @@ if [ "${CI:-}" = "true" ] || [ "${TOPOSLAM_SANITIZERS:-0}" = "1" ]; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs" -LE "slow|vm|browser" ${CTEST_ARGS:-}
 
-  echo "== thread sanitizer build and tests (pipeline, queues, worker pool)"
+  echo "== 3-minute soak of toposlamd under ASan + UBSan (scripts/soak.sh; no drops, flat RSS, no leaks)"
+  # The simulator's own 5 fps played in real time: ASan at -O1 keeps up with it on 2 cores.
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 MINUTES=3 FPS=5 SAMPLE_S=5 \
+    scripts/soak.sh "$root/build-asan"
+
+  echo "== thread sanitizer build and tests (pipeline, queues, worker pool, the map encoded off the topology thread)"
   # Only the targets whose code owns threads: OpenCV's own TBB threads are not instrumented, so TSan
   # cannot judge code that runs inside OpenCV's parallel loops (docs/architecture.md, "Sanitizers").
-  BUILD_TYPE=RelWithDebInfo BUILD_TARGETS="test_pipeline test_core" \
+  BUILD_TYPE=RelWithDebInfo BUILD_TARGETS="test_pipeline test_core test_topology" \
     scripts/build.sh "$root/build-tsan" -DTOPOSLAM_SANITIZE=thread -DTOPOSLAM_WERROR=ON "${sanitizer_flags[@]}"
   # Tests of the targets not built here are registered as *_NOT_BUILT (Catch2's discovery) or are plain
   # add_test() commands of unbuilt executables or files (fuzz corpus replays, the firmware C encoder, the
@@ -35,4 +40,9 @@ if [ "${CI:-}" = "true" ] || [ "${TOPOSLAM_SANITIZERS:-0}" = "1" ]; then
   TSAN_OPTIONS=halt_on_error=1 ctest --test-dir "$root/build-tsan" --output-on-failure -j "$jobs" \
     -E "_NOT_BUILT|^fuzz_replay_|^firmware-host-wheel-link-encoder$|^test_platform_udpm_reader$" \
     -LE "slow|vm|browser|e2e|cli" ${CTEST_ARGS:-}
+
+  echo "== libFuzzer targets, ${FUZZ_SECONDS:-20} s each (scripts/fuzz.sh; tests/fuzz/)"
+  # A fourth build (clang, ASan + UBSan, coverage): about 6 min with a warm ccache on 2 cores under load,
+  # then each target from its checked-in corpus. A crash fails CI; copy it into the corpus once fixed.
+  SECONDS_PER_TARGET="${FUZZ_SECONDS:-20}" BUILD_DIR="$root/build-fuzz" scripts/fuzz.sh
 fi

@@ -2,6 +2,7 @@
 #include "toposlam/pipeline/algorithm_stages.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -207,15 +208,25 @@ void ParticleFilterTopologyStage::refresh() {
 
 namespace {
 
-/// The encoded map file image; writing it is MapStore's atomic replace (temporary file, fsync, rename).
-class EncodedMap final : public MapSnapshot {
+/// The map as it was at one moment: the filter's frozen state (pointer copies, taken on the topology
+/// thread) and the application data. Encoding it, which grows with the map, happens in writeTo(), on the
+/// map writer thread, then MapStore's atomic replace (temporary file, fsync, rename).
+class FrozenMap final : public MapSnapshot {
  public:
-  explicit EncodedMap(std::string bytes) : bytes_(std::move(bytes)) {}
-  void writeTo(const std::string& path) const override { MapStore::writeAtomically(path, bytes_); }
-  std::size_t bytes() const override { return bytes_.size(); }
+  FrozenMap(FrozenTopologyState state, std::string application_data, MapSettings settings)
+      : state_(std::move(state)), application_data_(std::move(application_data)), settings_(std::move(settings)) {}
+  void writeTo(const std::string& path) const override {
+    const std::string bytes = MapStore::encode(state_, application_data_, settings_);
+    bytes_.store(bytes.size());
+    MapStore::writeAtomically(path, bytes);
+  }
+  std::size_t bytes() const override { return bytes_.load(); }
 
  private:
-  std::string bytes_;
+  FrozenTopologyState state_;
+  std::string application_data_;
+  MapSettings settings_;
+  mutable std::atomic<std::size_t> bytes_{0};
 };
 
 }  // namespace
@@ -224,7 +235,7 @@ std::unique_ptr<const MapSnapshot> ParticleFilterTopologyStage::snapshotMap() co
   std::ostringstream data;
   data << "toposlamd-frames";
   for (std::int64_t f : representative_frames_) data << ' ' << f;
-  return std::make_unique<EncodedMap>(MapStore::encode(*filter_, data.str(), map_settings_));
+  return std::make_unique<FrozenMap>(filter_->freeze(), data.str(), map_settings_);
 }
 
 }  // namespace toposlam

@@ -160,6 +160,8 @@ void Pipeline::start() {
   if (started_.exchange(true)) throw std::logic_error("Pipeline::start() called twice");
   start_time_s_ = clock_.now();
   for (auto& h : heartbeat_) h.store(start_time_s_);
+  last_frame_fingerprinted_s_.store(start_time_s_);
+  last_frame_failed_s_.store(start_time_s_);
   if (config_.record_latencies) latencies_ms_.reserve(1 << 16);
   {
     std::lock_guard lock(status_mutex_);
@@ -181,11 +183,21 @@ void Pipeline::requestStop() {
 
 void Pipeline::wait() { threads_.joinAll(); }
 
+double Pipeline::failingWithoutProgressFor(double now) const {
+  const double failed = last_frame_failed_s_.load();
+  const double passed = last_frame_fingerprinted_s_.load();
+  const double timeout = config_.heartbeat_timeout_s;
+  // Failing recently (not a camera that sent one bad frame and then went silent: silence is healthy).
+  if (failed > passed && now - failed <= timeout && now - passed > timeout) return now - passed;
+  return 0.0;
+}
+
 bool Pipeline::healthy() const {
   const double now = clock_.now();
   for (int i = 0; i < kThreadCount; ++i)
     if (!thread_done_[i].load() && !waiting_[i].load() && now - heartbeat_[i].load() > config_.heartbeat_timeout_s)
       return false;
+  if (!thread_done_[kFingerprint].load() && failingWithoutProgressFor(now) > 0.0) return false;
   return error().empty();
 }
 
@@ -198,6 +210,11 @@ std::string Pipeline::stalledStages() const {
     if (thread_done_[i].load() || waiting_[i].load() || silent <= config_.heartbeat_timeout_s) continue;
     char item[64];
     std::snprintf(item, sizeof item, "%s%s %.1f s", out.empty() ? "" : ", ", kNames[i], silent);
+    out += item;
+  }
+  if (const double failing = thread_done_[kFingerprint].load() ? 0.0 : failingWithoutProgressFor(now); failing > 0.0) {
+    char item[64];
+    std::snprintf(item, sizeof item, "%sframes failing %.1f s", out.empty() ? "" : ", ", failing);
     out += item;
   }
   return out;
@@ -237,7 +254,8 @@ void Pipeline::captureLoop() {
       // Bounded wait: a silent or reconnecting camera still lets this thread beat and see a stop.
       const SourceWait wait = source_.nextFor(kPollPeriod, frame);
       const FrameSourceState state = source_.state();
-      source_skipped_.store(source_.skippedFrames());
+      if (const std::int64_t skipped = source_.skippedFrames(); skipped > source_skipped_.exchange(skipped))
+        last_frame_failed_s_.store(clock_.now());  // the source skipped a frame (a bad file, an error buffer)
       source_reconnecting_.store(state.link == SourceLink::Reconnecting);
       source_reconnects_.store(state.reconnects);
       source_reconnect_attempts_.store(state.reconnect_attempts);
@@ -280,8 +298,10 @@ void Pipeline::fingerprintLoop() {
       } catch (const std::exception& e) {
         // A bad frame from the world: counted, logged now and then, survived.
         if (failures++ % 100 == 0) spdlog::warn("fingerprint: frame {} skipped ({} so far): {}", captured.frame.sequence, failures, e.what());
+        last_frame_failed_s_.store(clock_.now());
         continue;
       }
+      last_frame_fingerprinted_s_.store(clock_.now());
       FrameResult& r = out.result;
       r.sequence = captured.frame.sequence;
       r.source_time_s = captured.frame.timestamp_s;
@@ -358,13 +378,14 @@ void Pipeline::saveMap(bool final) {
 }
 
 void Pipeline::mapWriterLoop() {
-  // Writes snapshots with their fsync here, so a slow disk never holds up the topology thread.
+  // Encodes and writes snapshots with their fsync here, so neither a big map nor a slow disk holds up the
+  // topology thread.
   while (std::optional<MapWrite> job = map_writes_->pop()) {
     const double t0 = clock_.now();
     try {
       job->snapshot->writeTo(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
       maps_saved_.fetch_add(1);
-      spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, write {:.2f} ms "
+      spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, encode and write {:.2f} ms "
                    "in the map writer)",
                    config_.map_path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
     } catch (const std::exception& e) {

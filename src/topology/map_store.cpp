@@ -154,8 +154,13 @@ MapSettings fingerprintMapSettings(const VpackConfig& config) {
 
 std::string MapStore::encode(const TopologyParticleFilter& filter, std::string_view application_data,
                              const MapSettings& settings) {
+  return encode(filter.freeze(), application_data, settings);
+}
+
+std::string MapStore::encode(const FrozenTopologyState& frozen, std::string_view application_data,
+                             const MapSettings& settings) {
   std::ostringstream state;
-  filter.saveState(state);
+  frozen.saveState(state);
   topology_detail::BinaryWriter payload;
   payload.bytes(state.str());
   payload.bytes(application_data);

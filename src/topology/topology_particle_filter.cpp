@@ -510,9 +510,27 @@ TopologyMemoryStats TopologyParticleFilter::memoryStats() const {
 
 // ---- state (de)serialisation ---------------------------------------------------------------------
 
-void TopologyParticleFilter::saveState(std::ostream& out) const {
+FrozenTopologyState TopologyParticleFilter::freeze() const {
   if (phase_ != Phase::Idle)
     throw std::logic_error("TopologyParticleFilter::saveState: a step is in progress");
+  FrozenTopologyState frozen;
+  frozen.config_ = config_;
+  frozen.rng_ = rng_;
+  frozen.observation_count_ = observation_count_;
+  frozen.last_ess_ = last_ess_;
+  frozen.degenerate_steps_ = degenerate_steps_;
+  frozen.fingerprints_ = fingerprints_;
+  frozen.particles_ = particles_;
+  return frozen;
+}
+
+void TopologyParticleFilter::saveState(std::ostream& out) const { freeze().saveState(out); }
+
+// Reads only immutable data (the scalars copied here, the fingerprints, and the history records'
+// observation, node and parent), never the trie nodes' per-step memo fields, so the filter may step on
+// another thread meanwhile. A history record's parent is only changed by its destructor, once nothing
+// else (this state included) holds the record.
+void FrozenTopologyState::saveState(std::ostream& out) const {
   BinaryWriter w;
   w.i32(config_.particles);
   w.f64(config_.alpha);

@@ -373,6 +373,49 @@ SCENARIO("GIVEN a source hung inside next() THEN the pipeline is unhealthy (stal
   }
 }
 
+SCENARIO("GIVEN frames that keep arriving but all fail WHEN none is fingerprinted for longer than the heartbeat "
+         "limit THEN the pipeline is unhealthy and says so, and healthy again once frames pass") {
+  // Busy without progress (issue 19): every thread beats, yet nothing gets through, e.g. a camera that
+  // delivers only corrupt frames. The watchdog must not be fed by that.
+  ManualClock clock;
+  FakeSource source(-1);
+  FakeFingerprint fingerprint;
+  std::atomic<int> failed{0};
+  std::atomic<bool> frames_bad{true};
+  fingerprint.throw_when = [&](int) {
+    if (!frames_bad.load()) return false;
+    failed.fetch_add(1);
+    return true;
+  };
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  PipelineConfig config = losslessConfig();
+  config.heartbeat_timeout_s = 5.0;
+  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  // Waits until `n` more frames failed (the one counted first then has its failure time stored).
+  auto waitForFailures = [&](int n) {
+    const int target = failed.load() + n;
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (failed.load() < target && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+    return failed.load() >= target;
+  };
+  pipeline.start();
+  REQUIRE(waitForFailures(10));
+  CHECK_THAT(pipeline.stalledStages(), !Catch::Contains("frames failing"));  // 0 s so far
+  clock.advance(6.0);
+  REQUIRE(waitForFailures(2));  // a failure at 6 s: frames still arrive and fail
+  CHECK_FALSE(pipeline.healthy());
+  CHECK_THAT(pipeline.stalledStages(), Catch::Contains("frames failing 6.0 s"));
+  THEN("a frame that passes makes it healthy again, and it stops normally") {
+    frames_bad.store(false);
+    REQUIRE(sink.waitForFramesFor(1, std::chrono::seconds(10)));
+    CHECK_THAT(pipeline.stalledStages(), !Catch::Contains("frames failing"));
+    CHECK(stopsWithin(pipeline, source, std::chrono::seconds(10)));
+    CHECK(pipeline.error().empty());
+  }
+}
+
 SCENARIO("GIVEN a publisher that falls far behind WHEN drop-oldest queues overflow THEN only per-frame estimates are dropped") {
   ManualClock clock;
   FakeSource source(120);

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "fake_similarity.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -529,4 +530,37 @@ TEST_CASE("GIVEN saves killed with SIGKILL at random moments WHEN the map is rec
   }
   // Some kills land inside a save (a temporary file left behind); how many depends on the machine's speed.
   WARN("orphaned temporary files removed after " << kRuns << " kills: " << orphans_removed);
+}
+
+TEST_CASE("GIVEN a filter frozen between steps WHEN it goes on stepping while another thread encodes the "
+          "frozen state THEN that encodes exactly the map of the moment it was frozen",
+          "[topology][map][reliability]") {
+  // The daemon's map snapshot (issue 19): frozen on the topology thread (pointer copies), encoded on the map
+  // writer thread while the filter goes on. One representative per node, so later steps drop stored
+  // fingerprints the frozen state must keep alive.
+  auto sim = placeSimilarity();
+  TopologyFilterConfig c;
+  c.particles = 50;
+  c.seed = 5;
+  c.max_representatives_per_node = 1;
+  TopologyParticleFilter filter(c, sim);
+  for (int k = 0; k < 12; ++k) filter.step(taggedFingerprint(k % 4));
+  const std::string at_freeze = MapStore::encode(filter, "frames 1 2 3", {{"keypoints", "orb"}});
+  const FrozenTopologyState frozen = filter.freeze();
+  CHECK(frozen.observationCount() == 12);
+
+  std::string encoded_meanwhile;
+  std::thread writer([&] { encoded_meanwhile = MapStore::encode(frozen, "frames 1 2 3", {{"keypoints", "orb"}}); });
+  for (int k = 0; k < 24; ++k) filter.step(taggedFingerprint(k % 6));
+  writer.join();
+
+  CHECK(encoded_meanwhile == at_freeze);
+  CHECK(MapStore::encode(frozen, "frames 1 2 3", {{"keypoints", "orb"}}) == at_freeze);
+  CHECK(MapStore::encode(filter, "frames 1 2 3", {{"keypoints", "orb"}}) != at_freeze);
+  const LoadedMap loaded = MapStore::decode(at_freeze, sim);
+  CHECK(loaded.filter->observationCount() == 12);
+  CHECK(filter.observationCount() == 36);
+
+  filter.beginStep(taggedFingerprint(1));
+  CHECK_THROWS_AS(filter.freeze(), std::logic_error);  // not in the middle of a step
 }

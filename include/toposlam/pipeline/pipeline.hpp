@@ -17,7 +17,10 @@
 // The capture thread reads the source with a bounded wait (FrameSource::nextFor), so it keeps beating
 // while a camera is silent or reconnecting: that is healthy, and the status says "reconnecting". A stage
 // thread waiting for input is healthy too; only a thread stuck inside its work for heartbeat_timeout_s
-// (a stalled pipeline) makes healthy() false. requestStop() interrupts the source.
+// (a stalled pipeline) makes healthy() false. So does a pipeline that is busy without progress: frames
+// keep arriving but every one fails (skipped by the source, e.g. V4L2 error buffers, or refused by the
+// fingerprint stage) and none has been fingerprinted for heartbeat_timeout_s. requestStop() interrupts
+// the source.
 //
 // Thread-safety: start(), requestStop() and wait() from the owning thread; status(), healthy(),
 // finished() from any thread.
@@ -101,11 +104,12 @@ class Pipeline {
   /// True once every thread has ended (end of stream or stop).
   bool finished() const { return finished_threads_.load() == kThreadCount + 1; }
   /// False when a running stage thread has been inside its work (not waiting for input or a frame) for
-  /// heartbeat_timeout_s, or a stage failed (watchdog food). A camera away or silent is healthy.
+  /// heartbeat_timeout_s, when frames keep failing and none was fingerprinted for heartbeat_timeout_s,
+  /// or a stage failed (watchdog food). A camera away or silent is healthy.
   bool healthy() const;
-  /// The stage threads that make healthy() false by being inside their work for too long, as
-  /// "capture 6.0 s, topology 7.5 s" (seconds since their last heartbeat); "" when none. The daemon puts
-  /// it in its STATUS= so a stall that withholds the watchdog pings says where it is.
+  /// What makes healthy() false, as "capture 6.0 s, topology 7.5 s" (stage threads, seconds since their
+  /// last heartbeat) and "frames failing 6.0 s" (none fingerprinted meanwhile); "" when nothing. The
+  /// daemon puts it in its STATUS= so a stall that withholds the watchdog pings says where it is.
   std::string stalledStages() const;
   /// The last status published (updated every status period by the publisher thread).
   PipelineStatus status() const;
@@ -169,6 +173,13 @@ class Pipeline {
   // Copied by their owning thread so the publisher never calls into another thread's stage or source.
   std::atomic<std::int64_t> map_revision_{0};
   std::atomic<std::int64_t> source_skipped_{0};
+  /// Clock times of the last frame that failed (skipped by the source or refused by the fingerprint
+  /// stage) and of the last one fingerprinted: frames failing with none passing is no progress.
+  std::atomic<double> last_frame_failed_s_{0.0};
+  std::atomic<double> last_frame_fingerprinted_s_{0.0};
+  /// Seconds without a fingerprinted frame while frames keep failing (within heartbeat_timeout_s); 0 when
+  /// frames pass, none arrive, or not yet heartbeat_timeout_s.
+  double failingWithoutProgressFor(double now) const;
   std::atomic<bool> source_reconnecting_{false};
   std::atomic<std::int64_t> source_reconnects_{0};
   std::atomic<int> source_reconnect_attempts_{0};

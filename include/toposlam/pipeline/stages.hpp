@@ -110,15 +110,16 @@ class SegmentationStage {
   virtual std::optional<ClosedPlace> finish() = 0;
 };
 
-/// A copy of the map taken at one moment (in memory, cheap), written to disk later by another thread so
-/// the fsync never stalls the frame path.
+/// A copy of the map taken at one moment (in memory, cheap: the topology stage's freezes the filter's
+/// shared state), encoded and written to disk later by another thread so that neither the encoding, which
+/// grows with the map, nor the fsync stalls the frame path.
 class MapSnapshot {
  public:
   virtual ~MapSnapshot() = default;
   /// Replaces the map file at `path` atomically (readers and a crash see the old or the new map, never
   /// half of one). Throws std::runtime_error (or a subclass) on I/O failure. Any thread.
   virtual void writeTo(const std::string& path) const = 0;
-  /// Size of the file image in bytes (for the log).
+  /// Size of the file image in bytes (for the log; a snapshot that encodes in writeTo() knows it after).
   virtual std::size_t bytes() const = 0;
 };
 

@@ -126,6 +126,10 @@ class MapStore {
   /// The whole file image of `filter` (+ application data). Throws std::logic_error during a step.
   static std::string encode(const TopologyParticleFilter& filter, std::string_view application_data = {},
                             const MapSettings& settings = {});
+  /// The file image of a frozen state (TopologyParticleFilter::freeze()): what encode(filter) gave when
+  /// it was frozen. Any thread (see FrozenTopologyState).
+  static std::string encode(const FrozenTopologyState& state, std::string_view application_data = {},
+                            const MapSettings& settings = {});
   /// Parses a file image; `name` is used in error messages. Throws MapStoreError.
   static LoadedMap decode(std::string_view file, const SimilarityMeasure& similarity,
                           const std::string& name = "map");

@@ -147,6 +147,28 @@ struct TopologyMemoryStats {
   std::size_t stored_fingerprints = 0;
 };
 
+/// The filter's state between two steps, frozen (TopologyParticleFilter::freeze()). The particles and
+/// stored fingerprints are shared, immutable data, so taking it costs pointer copies (O(particles +
+/// observations)), while encoding it, which grows with the map, can be done later on another thread as
+/// the filter goes on: the pipeline takes it on the topology thread and encodes it on the map writer's.
+/// Thread-safety: saveState() from any one thread at a time; the filter may step meanwhile.
+class FrozenTopologyState {
+ public:
+  /// The bytes TopologyParticleFilter::saveState wrote at the moment freeze() was called.
+  void saveState(std::ostream& out) const;
+  int observationCount() const { return observation_count_; }
+
+ private:
+  friend class TopologyParticleFilter;
+  TopologyFilterConfig config_;
+  std::mt19937_64 rng_;
+  int observation_count_ = 0;
+  double last_ess_ = 0.0;
+  std::int64_t degenerate_steps_ = 0;
+  std::vector<std::shared_ptr<const Fingerprint>> fingerprints_;
+  std::vector<std::shared_ptr<const topology_detail::TopologyState>> particles_;
+};
+
 class TopologyParticleFilter {
  public:
   /// Throws std::invalid_argument with config.validate()'s message when invalid.
@@ -181,8 +203,11 @@ class TopologyParticleFilter {
   std::shared_ptr<const Fingerprint> storedRepresentative(int observation) const;
 
   /// Binary state (config, RNG, fingerprints, history, particles). Throws std::logic_error during a
-  /// step. Little-endian; framed, versioned and checksummed by MapStore.
+  /// step. Little-endian; framed, versioned and checksummed by MapStore. Same as freeze().saveState(out).
   void saveState(std::ostream& out) const;
+  /// The state as it is now, for saveState() later (see FrozenTopologyState). Throws std::logic_error
+  /// during a step.
+  FrozenTopologyState freeze() const;
   /// Inverse of saveState; throws std::runtime_error on malformed data.
   static std::unique_ptr<TopologyParticleFilter> loadState(std::istream& in,
                                                            const SimilarityMeasure& similarity);

@@ -4,7 +4,6 @@
 // traversal and consistency, topology (one-to-one, merged, split, wrong loop closures). Writes
 // RUN_DIR/eval.json. Several labels files (one per traversal, in the order the run read them) may be given.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -13,6 +12,7 @@
 
 #include "commands.hpp"
 #include "eval_cli_options.hpp"
+#include "toposlam/core/output_file.hpp"
 #include "toposlam/eval/evaluation.hpp"
 
 namespace toposlam::cli {
@@ -31,11 +31,11 @@ void runEval(const EvalCommandOptions& o) {
   const eval::Truth truth = eval::loadTruth(o.truth);
   const eval::EvalResult result = eval::evaluate(run, truth, o.eval);
   const std::filesystem::path json_path = std::filesystem::path(o.run_dir) / "eval.json";
-  std::ofstream json(json_path);
-  if (!json) throw std::runtime_error(json_path.string() + ": cannot write (is the run folder writable?)");
+  // Temporary name, checked, renamed: a full disk is an error naming the file and the eval.json of an
+  // earlier run is kept whole (it used to be truncated to what fitted).
+  OutputFile json(json_path);
   eval::writeEvalJson(json, result);
-  json.close();
-  if (!json) throw std::runtime_error(json_path.string() + ": error while writing");
+  json.commit();
   if (o.json) {
     eval::writeEvalJson(std::cout, result);
   } else {

@@ -6,10 +6,10 @@
 #include <memory>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "commands.hpp"
 #include "image_input.hpp"
+#include "offline_run_io.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -95,7 +95,7 @@ void addFingerprintCommand(CLI::App& app) {
           printText(path, f);
         if (!options->draw.empty()) {
           const std::string out = drawPath(options->draw, path, options->images.size());
-          if (!cv::imwrite(out, drawFingerprint(image, f))) throw std::runtime_error(out + ": cannot write");
+          writeImageFile(out, drawFingerprint(image, f));  // temporary name, checked, renamed
         }
       } catch (const std::exception& e) {
         // One bad image does not stop the others; the exit status says something failed.

@@ -259,6 +259,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
                              " refused)");
+  // The map first: it is the run's work and what --resume continues. A report file that cannot be
+  // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
+  MapSettings made_with = fingerprintMapSettings(vpack);
+  made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
+  MapStore::save(map_path, *filter, encodeOrigins(origins), made_with);
 
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter->estimate(3);
@@ -450,9 +455,6 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
     }
   }
-  MapSettings made_with = fingerprintMapSettings(vpack);
-  made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
-  MapStore::save(map_path, *filter, encodeOrigins(origins), made_with);
 
   std::printf(
       "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "

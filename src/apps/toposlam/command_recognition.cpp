@@ -17,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
 #include "image_input.hpp"
+#include "offline_run_io.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/output_file.hpp"
 #include "toposlam/core/svg_plot.hpp"
@@ -210,7 +210,7 @@ void writeHeatMap(const std::string& path, const MethodResult& m, const eval::Re
       for (int r = 0; r < truth.references; ++r)
         if (truth.at(q, r) == 1)
           cv::rectangle(big, cv::Rect(r * cell, q * cell, cell, cell), cv::Scalar(255, 255, 255), 1);
-  if (!cv::imwrite(path, big)) throw std::runtime_error(path + ": write failed");
+  writeImageFile(path, big);  // temporary name, checked, renamed
 }
 
 void writePrSvg(const std::string& path, const std::vector<MethodResult>& methods) {

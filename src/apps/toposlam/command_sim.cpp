@@ -6,15 +6,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "commands.hpp"
+#include "offline_run_io.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/sim/floor_plan.hpp"
 #include "toposlam/sim/map_drawing.hpp"
@@ -72,17 +71,16 @@ void runSim(const SimOptions& options) {
   std::error_code error;
   fs::create_directories(out / "frames", error);
   if (error) throw std::runtime_error("--out: cannot create '" + (out / "frames").string() + "': " + error.message());
-  std::ofstream labels(out / "labels.csv");
-  if (!labels) throw std::runtime_error("--out: cannot write '" + (out / "labels.csv").string() + "'");
+  // Every file goes through an OutputFile (temporary name, checked, renamed): a full disk is an error
+  // naming the file (exit 1), never "wrote".
+  OutputFile labels(out / "labels.csv");
   labels << "frame,time,room,x,y,heading,traversal\n";
   // The frames' capture times, read back by images: sources (the segmentation window is in seconds).
-  std::ofstream timestamps(out / "frames" / "timestamps.csv");
-  if (!timestamps) throw std::runtime_error("--out: cannot write '" + (out / "frames" / "timestamps.csv").string() + "'");
+  OutputFile timestamps(out / "frames" / "timestamps.csv");
   timestamps << "name,time_s\n";
   // The robot's own motion as its wheel odometry would report it, one sample per frame: distance driven
   // since the previous frame and the mean speed over it (read by `map --motion`; docs/segmentation.md).
-  std::ofstream motion(out / "motion.csv");
-  if (!motion) throw std::runtime_error("--out: cannot write '" + (out / "motion.csv").string() + "'");
+  OutputFile motion(out / "motion.csv");
   motion << "time_s,distance_m,speed_mps,turn_rate_rps\n";
   double previous_time_s = 0.0;
   std::vector<sim::Pose> poses;
@@ -94,9 +92,7 @@ void runSim(const SimOptions& options) {
     const sim::SimFrame frame = simulator.render(i);
     char name[32];
     std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(i));
-    if (!cv::imwrite((out / "frames" / name).string(), frame.image)) {
-      throw std::runtime_error("--out: cannot write frame " + (out / "frames" / name).string());
-    }
+    writeImageFile(out / "frames" / name, frame.image);
     char row[192];
     std::snprintf(row, sizeof row, "%lld,%.4f,%d,%.4f,%.4f,%.5f,%d\n", static_cast<long long>(i),
                   frame.truth.time_s, frame.truth.room, frame.truth.pose.x, frame.truth.pose.y,
@@ -125,14 +121,12 @@ void runSim(const SimOptions& options) {
       std::cerr << "sim: " << (i + 1) << "/" << frames << " frames\n";
     }
   }
-  if (!labels) throw std::runtime_error("--out: error while writing labels.csv");
-  timestamps.flush();
-  if (!timestamps) throw std::runtime_error("--out: error while writing frames/timestamps.csv");
-  motion.flush();
-  if (!motion) throw std::runtime_error("--out: error while writing motion.csv");
-  cv::imwrite((out / "loop_closure.png").string(), sim::loopClosureMatrix(rooms));
-  cv::imwrite((out / "map.png").string(),
-              sim::drawWorldMap(simulator.world(), poses, traversals, 40.0, static_cast<int>(config.fps * 5)));
+  labels.commit();
+  timestamps.commit();
+  motion.commit();
+  writeImageFile(out / "loop_closure.png", sim::loopClosureMatrix(rooms));
+  writeImageFile(out / "map.png",
+                 sim::drawWorldMap(simulator.world(), poses, traversals, 40.0, static_cast<int>(config.fps * 5)));
   std::cerr << "sim: wrote " << frames << " frames, labels.csv, motion.csv, loop_closure.png and map.png to " << out.string()
             << "\n";
 }

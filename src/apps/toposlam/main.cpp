@@ -4,6 +4,9 @@
 // Exit status, the same in every command and in toposlamd: 0 ok, 1 runtime error (a file, camera or the
 // network failed), 2 usage or config error (bad option, bad value, bad config file). CLI11's own codes
 // (105-109 and up) are folded into 2 here.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 
@@ -13,7 +16,25 @@
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/platform/logging.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+// What a command printed must have reached its reader: `toposlam fingerprint --json x > /dev/full` used to
+// exit 0 with nothing written. stdout is flushed here, before exit would do it silently; a failure is
+// exit 1 naming it (an error already reported keeps its own status).
+int checkStandardOutput(int status) {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout) != 0;
+  if (!failed) return status;
+  const int error = errno;
+  if (status == 0) {
+    std::cerr << "toposlam: error: standard output: write failed"
+              << (error != 0 ? std::string(": ") + std::strerror(error) : std::string()) << "\n";
+  }
+  return status == 0 ? 1 : status;
+}
+
+int run(int argc, char** argv) {
   CLI::App app{"toposlam: visual topological SLAM for indoor robots with one forward-facing camera"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "toposlam " TOPOSLAM_VERSION);  // project(VERSION), the package version
@@ -53,3 +74,7 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return checkStandardOutput(run(argc, argv)); }

@@ -4,6 +4,9 @@
 #include <cstdio>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
 
 #ifdef TOPOSLAM_HAVE_SOURCES
 #include "toposlam/io/source_factory.hpp"
@@ -22,6 +25,20 @@ std::unique_ptr<FrameSource> openSource(const std::string& uri) {
 }
 
 OutputFile openOutput(const std::filesystem::path& path) { return OutputFile(path); }
+
+void writeImageFile(const std::filesystem::path& path, const cv::Mat& image) {
+  std::vector<unsigned char> encoded;
+  bool ok = false;
+  try {
+    ok = cv::imencode(path.extension().string(), image, encoded);
+  } catch (const cv::Exception& e) {
+    throw OutputFileError(path.string() + ": cannot encode the image: " + e.err);
+  }
+  if (!ok) throw OutputFileError(path.string() + ": cannot encode the image");
+  OutputFile out(path);
+  out.write(reinterpret_cast<const char*>(encoded.data()), static_cast<std::streamsize>(encoded.size()));
+  out.commit();
+}
 
 void createRunFolder(const std::string& dir) {
   std::error_code error;

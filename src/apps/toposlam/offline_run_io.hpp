@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core/mat.hpp>
 
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/output_file.hpp"
@@ -27,6 +28,12 @@ std::unique_ptr<FrameSource> openSource(const std::string& uri);
 /// commit() when done, which checks every write and renames it over `path`. Throws OutputFileError
 /// naming the file (cannot create it, a full disk, ...). Not committed: nothing is written.
 OutputFile openOutput(const std::filesystem::path& path);
+
+/// Writes `image` to `path` in the format its extension names (.png, .jpg, ...) through an OutputFile:
+/// encoded in memory, written under a temporary name, checked and renamed. Throws OutputFileError naming
+/// the file when it cannot be encoded or written (a full disk), so an image is never reported as written
+/// when it is not, and a failed write leaves the old file in place.
+void writeImageFile(const std::filesystem::path& path, const cv::Mat& image);
 
 /// Creates the run folder; throws std::runtime_error naming it when it cannot.
 void createRunFolder(const std::string& dir);
