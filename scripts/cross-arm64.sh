@@ -124,12 +124,13 @@ if command -v ccache >/dev/null; then
 fi
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
+mkdir -p "$build"
 say "configuring $build"
 low cmake -S "$root" -B "$build" "${generator[@]}" "${launcher[@]}" \
   -DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchains/aarch64-linux-gnu.cmake" \
   -DTOPOSLAM_ARM64_SYSROOT="$sysroot" -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" -DTOPOSLAM_WERROR=ON \
-  -DTOPOSLAM_HELP2MAN=OFF >"$build.configure.log" 2>&1 ||
-  { tail -30 "$build.configure.log" >&2; die "cmake configure failed (whole log: $build.configure.log)"; }
+  -DTOPOSLAM_HELP2MAN=OFF >"$build/configure.log" 2>&1 ||
+  { tail -30 "$build/configure.log" >&2; die "cmake configure failed (whole log: $build/configure.log)"; }
 say "building (nice 19, $(nproc) jobs)"
 start=$(date +%s)
 low cmake --build "$build" -j "$(nproc)" || die "the arm64 build failed: see the compiler's message above"
