@@ -74,10 +74,12 @@ std::optional<MotionSample> MotionEstimator::wheelOdometry(const twl_wheel_odome
   const std::int64_t utime = controllerTime(m.time_us, host_us);
   const bool first = !have_previous_;
   // Wrapping differences: the counters are modulo 2^32 (C++20 conversions are modular).
-  const double dl = static_cast<std::int32_t>(static_cast<std::uint32_t>(m.left_um) -
-                                              static_cast<std::uint32_t>(prev_left_um_)) * 1e-6;
-  const double dr = static_cast<std::int32_t>(static_cast<std::uint32_t>(m.right_um) -
-                                              static_cast<std::uint32_t>(prev_right_um_)) * 1e-6;
+  const auto left_step_um = static_cast<std::int32_t>(static_cast<std::uint32_t>(m.left_um) -
+                                                      static_cast<std::uint32_t>(prev_left_um_));
+  const auto right_step_um = static_cast<std::int32_t>(static_cast<std::uint32_t>(m.right_um) -
+                                                       static_cast<std::uint32_t>(prev_right_um_));
+  const double dl = left_step_um * 1e-6;
+  const double dr = right_step_um * 1e-6;
   const double dt = (static_cast<double>(m.time_us) - static_cast<double>(prev_controller_us_)) * 1e-6;
   prev_left_um_ = m.left_um;
   prev_right_um_ = m.right_um;
@@ -87,7 +89,10 @@ std::optional<MotionSample> MotionEstimator::wheelOdometry(const twl_wheel_odome
   MotionSample s;
   s.utime = utime;
   s.forward_m = 0.5 * (dl + dr);
-  s.turn_rad = (dr - dl) / (m.track_mm * 1e-3);
+  // The wheels' difference in integer micrometres, so equal steps give exactly no turn on every CPU: from
+  // dr - dl, GCC on aarch64 fuses one product into the subtraction (fma) and leaves its rounding error.
+  s.turn_rad = static_cast<double>(static_cast<std::int64_t>(right_step_um) - left_step_um) * 1e-6 /
+               (m.track_mm * 1e-3);
   if (dt > 0) {
     s.linear_velocity_mps = s.forward_m / dt;
     s.angular_velocity_rps = s.turn_rad / dt;
