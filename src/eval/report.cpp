@@ -548,14 +548,10 @@ std::string renderReportHtml(const ReportInputs& in) {
              << "\" style=\"width:96px;height:72px;object-fit:cover;vertical-align:middle\"> ";
       html << p.representative << "</td><td>" << (p.node >= 0 ? std::to_string(p.node) : "-") << "</td>";
       if (in.rooms.size() == n) {
-        std::map<int, int> count;
-        for (std::int64_t f = p.first; f <= p.last; ++f) ++count[in.rooms[static_cast<std::size_t>(f)]];
-        int best_room = -1, best = 0;
-        for (const auto& [room, c] : count)
-          if (room >= 0 && c > best) best = c, best_room = room;
-        html << "<td>" << (best_room >= 0 ? std::to_string(best_room) + " (" +
-                                                num(100.0 * best / static_cast<double>(p.last - p.first + 1), 0) + " %)"
-                                          : std::string("-"))
+        const std::vector<int> rooms(in.rooms.begin() + p.first, in.rooms.begin() + p.last + 1);
+        const int room = majority(rooms);
+        const auto share = static_cast<double>(std::count(rooms.begin(), rooms.end(), room)) / rooms.size();
+        html << "<td>" << (room >= 0 ? std::to_string(room) + " (" + num(100.0 * share, 0) + " %)" : std::string("-"))
              << "</td>";
       }
       html << "</tr>\n";

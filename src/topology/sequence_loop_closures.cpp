@@ -40,6 +40,7 @@ SequenceLoopDetector::Detection SequenceLoopDetector::add(const std::vector<doub
   const double spread = std::max(sigma, config_.sigma_floor);
   // D(f, g) = (1 - decay) z_g + decay D(f-1, g-1), carried only where both f-1 -> f and g-1 -> g are
   // steps of one traversal (g = 0 and the first keyframe of a traversal start a diagonal).
+  if (next_.capacity() < n + 1) next_.reserve(2 * (n + 1));  // the two buffers swap: grow both geometrically
   next_.assign(n + 1, 0.0);  // one more slot: the new keyframe's own entry for the next call
   for (std::size_t g = 0; g < n; ++g) {
     const double z = n >= 2 ? (similarities[g] - mean) / spread : 0.0;

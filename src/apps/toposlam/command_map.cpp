@@ -143,8 +143,6 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   if (o.max_keypoints >= 0) vpack.keypoints.setMaxKeypoints(o.max_keypoints);
   const VpackExtractor extractor(vpack);
-  if (o.frame_loops != "sequence" && o.frame_loops != "visits")
-    throw std::invalid_argument("map: --frame-loops is sequence or visits (got '" + o.frame_loops + "')");
   // The thesis has no frame-level detector of its own: its preset reads frame closures off the topology.
   const bool by_sequence =
       o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
