@@ -15,8 +15,10 @@ namespace toposlam {
 
 FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
                                                    const SimilarityMeasure& similarity,
-                                                   std::size_t max_thumbnails, const MotionGateConfig& motion)
+                                                   std::size_t max_thumbnails, const MotionGateConfig& motion,
+                                                   const SequenceEvidenceConfig& evidence)
     : segmenter_(config, similarity),
+      evidence_(evidence.weight > 0.0 ? std::make_unique<PlaceSequenceEvidence>(evidence, similarity) : nullptr),
       max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)),
       gate_(motion) {
   thumbnails_.reserve(max_thumbnails_ + 1);
@@ -73,6 +75,7 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   if (!(std::isfinite(time_s) && time_s > last_source_time_s_))
     time_s = std::isfinite(last_source_time_s_) ? last_source_time_s_ + 1.0 : 0.0;
   last_source_time_s_ = time_s;
+  if (evidence_) evidence_->addFrame(sequence, time_s, fingerprint);
   SegmenterStep step = segmenter_.addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   if (motion_counters_ != nullptr) {
     const MotionUse use = last_motion_.known ? MotionUse::Used : gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
@@ -103,6 +106,7 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
     place.representative_frame = p.representative_frame;
     place.keypoints = p.representative_keypoints;
     place.representative = p.representative;
+    if (evidence_) place.evidence = evidence_->closePlace(p.first_frame, p.last_frame);
     const auto it = std::find_if(thumbnails_.begin(), thumbnails_.end(),
                                  [&](const auto& entry) { return entry.first == p.representative_frame; });
     if (it != thumbnails_.end()) place.thumbnail = it->second;
@@ -135,6 +139,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   // The application data lists the representative frames of the run that saved the map; frame numbers of
   // an older run mean nothing in this one, so resumed observations show -1.
   representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);
+  run_first_observation_ = filter_->observationCount();
   revision_ = 1;
   refresh();
 }
@@ -142,6 +147,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
 void ParticleFilterTopologyStage::enqueuePlace(const ClosedPlace& place) {
   queue_.push_back(place.representative);
   queued_frames_.push_back(place.representative_frame);
+  queued_evidence_.push_back(place.evidence);
 }
 
 std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budget_s) {
@@ -149,8 +155,13 @@ std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budge
   do {
     if (!filter_->stepInProgress()) {
       if (queue_.empty()) return std::nullopt;
-      filter_->beginStep(queue_.front());
+      // Evidence by earlier place of this run -> by filter observation.
+      const std::vector<double>& by_place = queued_evidence_.front();
+      step_evidence_.assign(by_place.empty() ? 0 : static_cast<std::size_t>(run_first_observation_), 0.0);
+      step_evidence_.insert(step_evidence_.end(), by_place.begin(), by_place.end());
+      filter_->beginStep(queue_.front(), step_evidence_);
       queue_.pop_front();
+      queued_evidence_.pop_front();
     }
     if (filter_->advance(slice_items_)) {
       representative_frames_.push_back(queued_frames_.front());

@@ -18,6 +18,7 @@
 #include "toposlam/pipeline/stages.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/topology/map_store.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -53,8 +54,11 @@ struct MotionSample {
 /// captured_at_s. Without samples the segmentation is exactly the one without motion.
 class FiedlerSegmentationStage final : public SegmentationStage {
  public:
+  /// `evidence` with weight > 0: every closed place carries the sequence evidence of its frames
+  /// (ClosedPlace::evidence; docs/topology.md). The default has weight 0: none.
   FiedlerSegmentationStage(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity,
-                           std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {});
+                           std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {},
+                           const SequenceEvidenceConfig& evidence = {});
   SegmentationStep process(std::int64_t sequence, double source_time_s, double captured_at_s, std::shared_ptr<const Fingerprint> fingerprint,
                            const cv::Mat& thumbnail) override;
   std::optional<ClosedPlace> finish() override;
@@ -80,6 +84,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::optional<ClosedPlace> toClosedPlace(const SegmentedPlace& place);
 
   FiedlerSegmenter segmenter_;
+  std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: no sequence evidence
   std::size_t max_thumbnails_;
   /// (frame, thumbnail) of the open place's frames, in arrival order; capacity max_thumbnails_ reserved
   /// once, so a frame costs no node allocation.
@@ -133,6 +138,9 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   std::deque<std::shared_ptr<const Fingerprint>> queue_;  ///< representatives waiting for their step
   std::vector<std::int64_t> representative_frames_;        ///< per observation (-1: from an older run)
   std::deque<std::int64_t> queued_frames_;
+  std::deque<std::vector<double>> queued_evidence_;  ///< per queued place: by earlier place of this run
+  int run_first_observation_ = 0;  ///< observation of this run's first place (after a loaded map)
+  std::vector<double> step_evidence_;  ///< scratch: the evidence by observation
   std::int64_t revision_ = 0;
   PlaceEstimate estimate_;
   TopologySnapshot topology_;
