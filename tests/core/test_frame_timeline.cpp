@@ -14,7 +14,8 @@ namespace {
 constexpr double kDt = 1.0 / 15.0;  // a camera at 15 fps
 }  // namespace
 
-TEST_CASE("GIVEN increasing timestamps WHEN placed THEN they are the timeline unchanged", "[core][reliability]") {
+TEST_CASE("GIVEN increasing timestamps WHEN placed THEN they are the timeline unchanged",
+          "[core][reliability]") {
   FrameTimeline timeline;
   for (int f = 0; f < 100; ++f) {
     const double t = 1000.0 + f * kDt + (f % 3 == 0 ? 0.004 : 0.0);  // jitter forward is kept

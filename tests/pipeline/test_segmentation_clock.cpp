@@ -44,7 +44,7 @@ FiedlerSegmenterConfig windowInSeconds() {
 using Places = std::vector<std::pair<std::int64_t, std::int64_t>>;
 
 struct Segmented {
-  Places places;              ///< closed places: first and last frame
+  Places places;                ///< closed places: first and last frame
   std::vector<double> lambda2;  ///< per frame (NaN until the window is full)
   std::int64_t steps_back = 0;
 };
@@ -78,7 +78,8 @@ int differingFrames(const Segmented& a, const Segmented& b) {
 }  // namespace
 
 TEST_CASE(
-    "GIVEN a camera clock stepped back 30 s in the second place WHEN segmenting by seconds THEN every frame's "
+    "GIVEN a camera clock stepped back 30 s in the second place WHEN segmenting by seconds THEN every "
+    "frame's "
     "window is the one of the honest clock (same lambda2, same places) and the step is counted",
     "[pipeline][reliability][clock]") {
   const Segmented honest = segment([](int f) { return 1000.0 + f * kDt; });
@@ -106,7 +107,8 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "GIVEN a camera clock stepped forward an hour inside a place WHEN segmenting by seconds THEN it is a gap: "
+    "GIVEN a camera clock stepped forward an hour inside a place WHEN segmenting by seconds THEN it is a "
+    "gap: "
     "the window restarts there (min_window_frames), and the places stay",
     "[pipeline][reliability][clock]") {
   const Segmented honest = segment([](int f) { return 1000.0 + f * kDt; });
