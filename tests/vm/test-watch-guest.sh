@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The VM test's budget logic (tests/vm/watch-guest.sh with tests/vm/budget.sh), without QEMU: a fake
 # guest writes the console lines with chosen delays, limits are 1-2 s.
-#   1. a guest whose boot says "3x slower" (7.5 s) gets 3 s for a 1 s step and passes, taking 2 s;
+#   1. a guest whose boot says "4x slower" (10 s) gets 4 s for a 1 s step and passes, taking 2 s;
 #   2. the same steps after an idle boot (2.0 s): the 2-s step overruns its 1 s and is stopped, named;
 #   3. a guest stuck in a step is stopped within its limit x slowness, and the process is gone;
 #   4. no boot line within TOPOSLAM_VM_BOOT_LIMIT: stopped; 5. the factor is capped (boot 100 s: 6.00).
@@ -21,12 +21,12 @@ fake_guest() {
     echo "VMTEST DONE failures=0"; sleep 0.3; } >"$1"
 }
 
-fake_guest "$work/slow.log" 7.5 2 & pid=$!
+fake_guest "$work/slow.log" 10.0 2 & pid=$!
 out=$("$here/watch-guest.sh" "$work/slow.log" $pid); rc=$?
 echo "$out" | sed 's/^/  | /'
-check "a 3x slower guest with a 2 s step (limit 1 s x 3) passes" '[ $rc -eq 0 ]'
-check "it measured slowness 3.00" 'echo "$out" | grep -q "slowness 3.00 "'
-check "it timed the first step" 'echo "$out" | grep -Eq "step .first step. took [12]\.[0-9] s here \(limit 1 s x 3.00\)"'
+check "a 4x slower guest with a 2 s step (limit 1 s x 4) passes" '[ $rc -eq 0 ]'
+check "it measured slowness 4.00" 'echo "$out" | grep -q "slowness 4.00 "'
+check "it timed the first step" 'echo "$out" | grep -Eq "step .first step. took [12]\.[0-9] s here \(limit 1 s x 4.00\)"'
 
 fake_guest "$work/idle.log" 2.0 2 & pid=$!
 out=$("$here/watch-guest.sh" "$work/idle.log" $pid); rc=$?
