@@ -69,12 +69,15 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   }
   // The window's clock is the frame's source time (a window in seconds of the world, also when a file or
   // the simulator plays faster than real time); motion is looked up at the pipeline clock, the clock of
-  // motion_t.utime. A source time that does not increase (a source without timestamps) falls back to
-  // the frame number, so the window still moves.
-  double time_s = source_time_s;
-  if (!(std::isfinite(time_s) && time_s > last_source_time_s_))
-    time_s = std::isfinite(last_source_time_s_) ? last_source_time_s_ + 1.0 : 0.0;
-  last_source_time_s_ = time_s;
+  // motion_t.utime. A source time that goes back is carried on from the previous frame (FrameTimeline),
+  // so the window neither keeps every frame "from the future" nor turns into a window of frames; one that
+  // does not increase (a source without timestamps) advances by a second, as before.
+  const std::int64_t steps_back = timeline_.stepsBack();
+  const double time_s = timeline_.place(source_time_s);
+  if (timeline_.stepsBack() > steps_back && (steps_back < 10 || steps_back % 1000 == 0))
+    spdlog::warn("segmentation: frame {}'s source time went back {:.3f} s (to {:.3f} s); the window's clock carries on "
+                 "from the frame before ({} such steps so far)",
+                 sequence, timeline_.lastStepBackS(), source_time_s, steps_back + 1);
   if (evidence_) evidence_->addFrame(sequence, time_s, fingerprint);
   SegmenterStep step = segmenter_.addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   if (motion_counters_ != nullptr) {

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/stages.hpp"
@@ -49,6 +50,11 @@ struct MotionSample {
 /// dropped) so the closed place's representative has its picture. Dropped places (too few keypoints) are
 /// counted and not passed on.
 ///
+/// The window's clock is the frames' source time through a FrameTimeline: a source time that goes back
+/// (a recording's clock stepped back, broken video PTS) is carried on from the previous frame at the
+/// typical interval and counted (sourceTimeStepsBack()), logged now and then; a jump forward is a gap
+/// (docs/reliability.md, "Clock jumps").
+///
 /// Motion (docs/segmentation.md, "Motion-aware segmentation"): samples given to addMotion() (any thread)
 /// are applied to a MotionGate, in order, before the next frame; each frame then asks the gate at its
 /// captured_at_s. Without samples the segmentation is exactly the one without motion.
@@ -74,6 +80,9 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::int64_t skippedFrames() const { return segmenter_.skippedFrames(); }
   std::int64_t refusedMotionSamples() const { return gate_.rejectedSamples(); }
   std::int64_t droppedMotionSamples() const;
+  /// Segmentation thread (or after it ended): frames whose source time went back, which the window's
+  /// clock carried on from the frame before (FrameTimeline).
+  std::int64_t sourceTimeStepsBack() const { return timeline_.stepsBack(); }
   /// From now on, every frame writes whether motion is used and the standing frames so far into
   /// `counters` (may be null: nowhere), which must outlive the stage; any thread may read them.
   void reportMotionTo(MotionStatusCounters* counters) { motion_counters_ = counters; }
@@ -93,7 +102,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 
   MotionGate gate_;
   MotionState last_motion_;
-  double last_source_time_s_ = -std::numeric_limits<double>::infinity();  ///< the window's clock so far
+  FrameTimeline timeline_;  ///< the window's clock: source times with their steps back cut out
   mutable std::mutex motion_mutex_;
   std::deque<MotionSample> pending_motion_;  ///< guarded by motion_mutex_
   std::deque<MotionSample> applying_;        ///< segmentation thread: swapped out of pending_motion_

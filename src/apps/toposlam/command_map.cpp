@@ -235,6 +235,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::unique_ptr<FrameSource> source = openSource(uri);
     std::cerr << "map: " << source->describe() << "\n";
     mapper.beginTraversal();  // fresh segmentation window per traversal
+    // Each traversal's own clock, with any step back inside it cut out (docs/reliability.md, "Clock
+    // jumps"); the next source starts its own, so where it goes back a new traversal begins (frames.csv).
+    FrameTimeline timeline;
     while (std::optional<Frame> frame = source->next()) {
       FrameTiming t;
       t.filter_ms = 0.0;
@@ -254,7 +257,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
       const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
-      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint), moving);
+      const SegmenterStep step = mapper.segment(timeline.place(frame->timestamp_s), name, std::move(fingerprint), moving);
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
@@ -263,6 +266,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (auto last = mapper.finishTraversal()) mapPlace(*last);
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
+    if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "map") << "\n";
   }
   if (motion) std::cerr << motionSummary(*motion, o.motion, "map") << "\n";
   const SegmentationRun all = mapper.run();
