@@ -188,7 +188,7 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"similarity: {histogram_weight: 2}", "similarity.histogram_weight: 2 is out of range, allowed [0, 1]"},
       {"segmentation: {window: 2}", "segmentation.window: 2 is out of range, allowed 3 .. 1000 frames"},
       {"segmentation: {valley: {gamma: 0.2, delta: 0.3}}", "segmentation.valley.delta: 0.3 is out of range, allowed [0, gamma = 0.2]"},
-      {"segmentation: {window: 3, valley: {gamma: 1.6}}", "segmentation.valley.gamma: 1.6 is out of range, allowed [0, window / (window - 1) = 1.5]"},
+      {"segmentation: {window: 3, min_window_frames: 3, valley: {gamma: 1.6}}", "segmentation.valley.gamma: 1.6 is out of range, allowed [0, window / (window - 1) = 1.5]"},
       {"segmentation: {cut_placement: middle}", "segmentation.cut_placement: 'middle' is not allowed"},
       {"segmentation: {window_m: -1}", "segmentation.window_m: -1 is out of range, allowed [0, 1000] metres"},
       {"segmentation: {motion: {timeout_s: 0}}", "segmentation.motion.timeout_s: 0 is out of range, allowed (0, 3600] seconds"},
