@@ -382,7 +382,7 @@ std::vector<ConfigKey> makeKeys() {
                            " is out of range, allowed [0, window / (window - 1) = " + rangeNumber(max) + "]";
                   }));
   k.push_back(real("segmentation.valley.delta", AT(segmentation.valley.delta), 0.30, 0, 2, "",
-                   "rise and fall between peak and valley (thesis: 0.25)")
+                   "rise and fall between peak and valley")
                   .withNote("and <= gamma")
                   .withCrossCheck([](const DaemonConfig& c) -> std::string {
                     if (c.segmentation.valley.delta <= c.segmentation.valley.gamma) return "";
@@ -414,10 +414,10 @@ std::vector<ConfigKey> makeKeys() {
                    "probability of a new node from a known one (thesis: 0.05)")
                   .exclusive(true, true));
   k.push_back(real("topology.gamma_shape", AT(topology.gamma_shape), 5.0, 0, 1000, "",
-                   "successor gamma pdf shape (thesis: 10; 5 and 0.4 give staying 0.33, docs/topology.md)")
+                   "successor gamma pdf shape (5 and scale 0.4 give staying 0.33, docs/topology.md)")
                   .exclusive(true, false));
   k.push_back(real("topology.gamma_scale", AT(topology.gamma_scale), 0.4, 0, 100, "",
-                   "successor gamma pdf scale (thesis: 0.25)")
+                   "successor gamma pdf scale")
                   .exclusive(true, false));
   k.push_back(integer("topology.max_successors", AT(topology.max_successors), 5, 1, kTopologyMaxSuccessors, "",
                       "successors proposed from a known node"));
@@ -545,6 +545,12 @@ const std::vector<ConfigSection>& daemonConfigSections() {
       {"pipeline", "queues, threads and time budgets of the daemon's pipeline (docs/daemon.md)"},
       {"pipeline.queues", "queue capacities between the stage threads"},
       {"pipeline.threads", "per thread: name, CPU pinning, scheduling policy, priority, nice"},
+      {"pipeline.threads.capture", "reads frames from the source"},
+      {"pipeline.threads.fingerprint", "fingerprints frames (with fingerprint.workers - 1 pool threads)"},
+      {"pipeline.threads.segmentation", "segments the stream into places"},
+      {"pipeline.threads.topology", "runs the particle filter over topologies"},
+      {"pipeline.threads.publisher", "publishes over LCM"},
+      {"pipeline.threads.map_writer", "writes map snapshots (fsync off the frame path)"},
       {"fingerprint", "VPACK fingerprint (thesis ch. 3, docs/fingerprint.md)"},
       {"fingerprint.edges", "vertical edges"},
       {"fingerprint.histogram", "HCL colour histograms"},
