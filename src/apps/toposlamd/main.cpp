@@ -57,13 +57,16 @@ int main(int argc, char** argv) {
   for (const toposlam::ConfigKey& key : toposlam::daemonConfigKeys()) {
     if (key.option.empty()) continue;
     auto o = std::make_unique<Override>(Override{&key, nullptr, {}});
-    const std::string help = "override `" + key.path + "`: " + key.help;
     if (key.kind == toposlam::ConfigKind::Flag) {
-      o->option = app.add_flag(key.option, help);
       o->text = key.option_sets ? "true" : "false";
+      const std::string help = "set `" + key.path + "` to " + o->text + " (" + key.help + ")";
+      o->option = app.add_flag(key.option, help);
     } else {
-      o->option = app.add_option(key.option, o->text, help + " (" + key.rangeText() + ")");
+      o->option = app.add_option(key.option, o->text,
+                                 "override `" + key.path + "`: " + key.help + " (" + key.rangeText() + ")");
       if (key.kind == toposlam::ConfigKind::Choice) o->option->check(CLI::IsMember(key.choices));
+      if (key.kind == toposlam::ConfigKind::Integer) o->option->type_name("INT");
+      if (key.kind == toposlam::ConfigKind::Real) o->option->type_name("NUMBER");
     }
     overrides.push_back(std::move(o));
   }
