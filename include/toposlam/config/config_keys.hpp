@@ -5,9 +5,11 @@
 // options, `toposlamd --print-config`, the comments of the shipped config/toposlam.yaml and the key
 // table of docs/config.md (config_text.hpp; a test keeps both files equal to what the table makes).
 //
-// Adding a key: one entry in daemonConfigKeys() (config_keys.cpp), e.g.
-//   integer("pipeline.queues.frames", AT(pipeline.queues.frames), 2, 1, 1024, "frames", "capture -> fingerprint"),
-// plus the member in its struct. Nothing else lists keys.
+// Adding a key: the member in its struct and one entry in makeKeys() (config_keys.cpp), e.g.
+//   k.push_back(integer("pipeline.queues.frames", AT(pipeline.queues.frames), 2, 1, 1024, "frames", "capture -> fingerprint"));
+// (append .withOption("--name") for a toposlamd option; a new section also needs its line in
+// daemonConfigSections()), then regenerate config/toposlam.yaml and docs/config.md with
+// `toposlam config --shipped` / `--docs` (test_config_keys fails until they match). Nothing else lists keys.
 #pragma once
 
 #include <cstddef>
