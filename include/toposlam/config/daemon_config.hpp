@@ -1,9 +1,10 @@
 // The one validated configuration of toposlamd (and of `toposlam` commands that run the pipeline):
 // every stage's config struct (defaults in code, validate() in its module) plus the daemon's own keys,
-// loaded once from YAML (config/toposlam.yaml documents every key). Unknown keys and out-of-range or
-// ill-typed values are refused at start with the key's full dotted name and its allowed range; absent
-// keys keep their defaults. No string look-ups happen after loading: stages get their structs by const
-// reference.
+// loaded once from YAML. Which YAML key lands in which member, with its default, range, unit and help,
+// is written once, in the key table (config_keys.hpp); the reader and validate() here are made from it.
+// Unknown and repeated keys are refused with their path and line, out-of-range or ill-typed values with
+// the key's full dotted name and its allowed range; absent keys keep their defaults. No string look-ups
+// happen after loading: stages get their structs by const reference.
 #pragma once
 
 #include <stdexcept>
@@ -63,9 +64,14 @@ struct DaemonConfig {
   int topology_alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
 
   DaemonConfig();
-  /// "" or "<full.dotted.key>: <problem, allowed range>" (also runs every stage's validate()).
+  /// "" or "<full.dotted.key>: <problem, allowed range>": every key's range and cross-key constraint of
+  /// the key table, then every stage's own validate() as a backstop.
   std::string validate() const;
 };
+
+/// Sets `config.preset` and every stage's settings from the method preset `name` (method_preset.hpp).
+/// Throws std::invalid_argument for an unknown name.
+void applyMethodPreset(const std::string& name, DaemonConfig& config);
 
 /// Parses YAML text onto the defaults. `origin` names the text in messages (a file name).
 /// Throws ConfigError on syntax errors, unknown keys, wrong types and out-of-range values.
@@ -75,5 +81,10 @@ inline constexpr std::size_t kMaxConfigBytes = 1 << 20;
 /// Reads and parses a file; ConfigError if it cannot be read, is a folder or is over kMaxConfigBytes.
 /// A repeated key or a second YAML document is refused (parseDaemonConfig).
 DaemonConfig loadDaemonConfig(const std::string& path);
+
+/// Sets the key at `path` (a key of the table) from its text as written on a command line, e.g.
+/// ("map.save_period_s", "30"); ConfigError naming the key if the text is not a value of its kind.
+/// Ranges are checked by validate().
+void setConfigValue(DaemonConfig& config, const std::string& path, const std::string& text);
 
 }  // namespace toposlam

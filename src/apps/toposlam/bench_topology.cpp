@@ -13,6 +13,7 @@
 
 #include "bench_stats.hpp"
 #include "commands.hpp"
+#include "config_key_options.hpp"
 #include "image_input.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
@@ -24,7 +25,7 @@ namespace {
 
 struct TopologyBenchOptions {
   std::vector<int> places = {10, 100, 1000};
-  int particles = 500;
+  int particles = keyDefaultInt("topology.particles");
   int steps = 100;   ///< measured steps (a second traversal) per map size
   int budget = 250;  ///< work items per slice for the sliced measurement
   std::string samples;
@@ -144,7 +145,7 @@ void addBenchTopology(CLI::App& bench) {
   auto* cmd = bench.add_subcommand("topology", "ms per particle-filter step at 10, 100, 1000 places");
   cmd->add_option("--places", options->places, "Map sizes to measure")->capture_default_str();
   cmd->add_option("--particles", options->particles, "Particles")
-      ->check(CLI::Range(1, 1000000))
+      ->check(keyRange("topology.particles"))
       ->capture_default_str();
   cmd->add_option("--steps", options->steps, "Measured steps per map size")
       ->check(CLI::Range(2, 100000))

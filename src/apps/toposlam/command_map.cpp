@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "config_key_options.hpp"
 #include "offline_run_io.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -52,10 +53,10 @@ namespace fs = std::filesystem;
 struct MapOptions {
   std::vector<std::string> sources;
   std::string out;
-  int particles = 500;
-  double alpha = 15.0;
-  std::uint64_t seed = 1;
-  int max_representatives = 8;
+  int particles = keyDefaultInt("topology.particles");
+  double alpha = daemonConfigKey("topology.alpha").defaultNumber();
+  std::uint64_t seed = static_cast<std::uint64_t>(daemonConfigKey("topology.seed").defaultNumber());
+  int max_representatives = keyDefaultInt("topology.max_representatives_per_node");
   std::string resume;
   bool resume_other_source = false;  ///< --resume-other-source: continue a map made from another source
   std::string keypoints = "orb";
@@ -494,7 +495,7 @@ void addMapCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--out", options->out, "Output run folder")->required();
   auto* particles = cmd->add_option("--particles", options->particles, "Particles (thesis: 500)")
-                        ->check(CLI::Range(1, 1000000))
+                        ->check(keyRange("topology.particles"))
                         ->capture_default_str();
   auto* alpha = cmd->add_option("--alpha", options->alpha, "Prior map size of eq. 5.8 (thesis: 15)")
                     ->capture_default_str();
@@ -557,7 +558,7 @@ void addMapCommand(CLI::App& app) {
                              ->capture_default_str();
   auto* reps = cmd->add_option("--max-representatives", options->max_representatives,
                                "Representatives kept per node (oldest dropped)")
-                   ->check(CLI::Range(1, kTopologyMaxRepresentatives))
+                   ->check(keyRange("topology.max_representatives_per_node"))
                    ->capture_default_str();
   cmd->add_option("--resume", options->resume, "Continue the map in this map.tsm");
   cmd->add_flag("--resume-other-source", options->resume_other_source,

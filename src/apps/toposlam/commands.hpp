@@ -15,6 +15,7 @@ void addSimCommand(CLI::App& app);
 void addEvalCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addListenCommand(CLI::App& app);
+void addConfigCommand(CLI::App& app);
 void addSimilarityCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);
 void addRecognitionCommand(CLI::App& app);

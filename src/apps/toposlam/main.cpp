@@ -1,5 +1,5 @@
 // toposlam: the offline command-line tool (fingerprint, similarity, localize, segment, map, sim, eval,
-// report, bench, listen). Thin: it parses arguments, builds the objects and runs them.
+// report, bench, listen, config). Thin: it parses arguments, builds the objects and runs them.
 //
 // Exit status, the same in every command and in toposlamd: 0 ok, 1 runtime error (a file, camera or the
 // network failed), 2 usage or config error (bad option, bad value, bad config file). CLI11's own codes
@@ -55,6 +55,7 @@ int run(int argc, char** argv) {
   toposlam::cli::addEvalCommand(app);
   toposlam::cli::addReportCommand(app);
   toposlam::cli::addListenCommand(app);
+  toposlam::cli::addConfigCommand(app);
   toposlam::cli::addSimilarityCommand(app);
   toposlam::cli::addLocalizeCommand(app);
   toposlam::cli::addRecognitionCommand(app);

@@ -1,5 +1,6 @@
 // Motion CSV for the offline commands: see motion_input.hpp.
 #include "motion_input.hpp"
+#include "config_key_options.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -56,7 +57,7 @@ void addMotionOptions(CLI::App& command, MotionOptions& options) {
                      "sim's motion.csv): frames taken standing are not segmented");
   command.add_option("--window-m", options.window_m, "With --motion: segmentation window in metres of travel (0: by time)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(keyRange("segmentation.window_m"));
 }
 
 std::optional<MotionReplay> openMotion(const MotionOptions& options, std::size_t sources, const std::string& command,

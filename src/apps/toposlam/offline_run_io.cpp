@@ -1,5 +1,6 @@
 // Shared pieces of `toposlam segment` and `toposlam map` (see offline_run_io.hpp).
 #include "offline_run_io.hpp"
+#include "config_key_options.hpp"
 
 #include <cstdio>
 #include <stdexcept>
@@ -88,18 +89,18 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
                                         "Segmentation: sliding window in seconds, from the frames' timestamps "
                                         "(0 = --window frames)")
                          ->capture_default_str()
-                         ->check(CLI::Range(0.0, 3600.0)),
+                         ->check(keyRange("segmentation.window_s")),
                      kWindowS);
   given.emplace_back(command.add_option("--window", c.window,
                                         "Segmentation: window in frames with --window-s 0, else the most frames "
                                         "it may hold")
                          ->capture_default_str()
-                         ->check(CLI::Range(3, 1000)),
+                         ->check(keyRange("segmentation.window")),
                      kWindow);
   given.emplace_back(command.add_option("--min-window-frames", c.min_window_frames,
                                         "Segmentation: fewest frames a window in seconds keeps")
                          ->capture_default_str()
-                         ->check(CLI::Range(3, 1000)),
+                         ->check(keyRange("segmentation.min_window_frames")),
                      kMinWindowFrames);
   given.emplace_back(command.add_option("--gamma", c.valley.gamma, "Segmentation: minimum lambda2 of a peak, [0, n/(n-1)]")
                          ->capture_default_str(),

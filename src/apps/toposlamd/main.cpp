@@ -5,14 +5,18 @@
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
 #include "sources.hpp"
+#include "toposlam/config/config_keys.hpp"
 #include "toposlam/config/config_path.hpp"
+#include "toposlam/config/config_text.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/io/frame_source.hpp"
 #include "toposlam/platform/logging.hpp"
@@ -38,25 +42,42 @@ int main(int argc, char** argv) {
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
-  std::string source, map_path, lcm_url, overflow;
-  bool check_only = false, no_load = false, bench = false, resume_other_source = false;
-  std::string log_level;
-  double save_period = -1.0;
+  bool check_only = false, print_config = false, bench = false;
   toposlam::daemon::BenchOptions bench_options;
-  app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
+  app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml and docs/config.md). Default: " +
                                                  toposlam::defaultDaemonConfigPath() + " if it exists, else built-in defaults");
-  app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
-  auto* map_option = app.add_option("--map", map_path,
-                                    "override `map.path` (relative paths resolve against $STATE_DIRECTORY; \"\" = never saved)");
-  app.add_option("--lcm-url", lcm_url, "override `lcm.url`");
-  app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
-  app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
-  app.add_flag("--no-map-load", no_load, "start a new map even if the map file exists");
-  app.add_flag("--resume-other-source", resume_other_source,
-               "override `map.resume_other_source`: continue a map made from another source");
-  app.add_option("--log-level", log_level, "override `log.level`: trace, debug, info, warn or error")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  // The override options come from the key table (config_keys.cpp): one per key that names one. A flag
+  // sets its key to the table's value; any other option takes the key's value as on the YAML side.
+  struct Override {
+    const toposlam::ConfigKey* key;
+    CLI::Option* option;
+    std::string text;
+  };
+  std::vector<std::unique_ptr<Override>> overrides;
+  for (const toposlam::ConfigKey& key : toposlam::daemonConfigKeys()) {
+    if (key.option.empty()) continue;
+    auto o = std::make_unique<Override>(Override{&key, nullptr, {}});
+    if (key.kind == toposlam::ConfigKind::Flag) {
+      o->text = key.option_sets ? "true" : "false";
+      const std::string help = "set `" + key.path + "` to " + o->text + " (" + key.help + ")";
+      o->option = app.add_flag(key.option, help);
+    } else {
+      o->option = app.add_option(key.option, o->text,
+                                 "override `" + key.path + "`: " + key.help + " (" + key.rangeText() + ")");
+      if (key.kind == toposlam::ConfigKind::Choice) o->option->check(CLI::IsMember(key.choices));
+      if (key.kind == toposlam::ConfigKind::Integer) o->option->type_name("INT");
+      if (key.kind == toposlam::ConfigKind::Real) o->option->type_name("NUMBER");
+    }
+    overrides.push_back(std::move(o));
+  }
+  const auto given = [&](const std::string& path) -> const Override* {
+    for (const auto& o : overrides)
+      if (o->key->path == path && o->option->count() > 0) return o.get();
+    return nullptr;
+  };
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
+  app.add_flag("--print-config", print_config,
+               "print the effective config (file, defaults and options) as YAML with every key, and exit");
   app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
   app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
   try {
@@ -67,7 +88,9 @@ int main(int argc, char** argv) {
   }
   // stderr, in the journal's format under systemd; the level of --log-level, else info until the config
   // has been read (its log.level then applies).
-  const bool journal = g_journal = toposlam::configureLogging("toposlamd", *toposlam::parseLogLevel(log_level.empty() ? "info" : log_level));
+  const Override* level_option = given("log_level");
+  const bool journal = g_journal =
+      toposlam::configureLogging("toposlamd", *toposlam::parseLogLevel(level_option ? level_option->text : "info"));
 
   try {
     toposlam::DaemonConfig config;
@@ -78,18 +101,24 @@ int main(int argc, char** argv) {
     } else {
       config_path = "(built-in defaults)";
     }
-    if (!source.empty()) config.source = source;
-    if (map_option->count() > 0) config.pipeline.map_path = map_path;  // --map "" means no map file
-    if (!lcm_url.empty()) config.lcm.url = lcm_url;
-    if (overflow == "block") config.pipeline.queues.overflow = toposlam::QueueOverflow::Block;
-    if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
-    if (save_period >= 0.0) config.pipeline.map_save_period_s = save_period;
-    if (no_load) config.load_map_at_start = false;
-    if (resume_other_source) config.map_resume_other_source = true;
-    if (!log_level.empty()) config.log_level = log_level;
+    bool options_given = false;
+    for (const auto& o : overrides) {
+      if (o->option->count() == 0) continue;
+      options_given = true;
+      try {
+        toposlam::setConfigValue(config, o->key->path, o->text);
+      } catch (const toposlam::ConfigError& e) {
+        throw toposlam::ConfigError("command line: " + o->key->option + ": " + e.what());
+      }
+    }
     spdlog::default_logger()->set_level(*toposlam::parseLogLevel(config.log_level));
     if (std::string problem = config.validate(); !problem.empty())
       throw toposlam::ConfigError("command line: " + problem);
+    if (print_config) {
+      std::cout << "# toposlamd's effective config: " << config_path << (options_given ? " and the options" : "")
+                << "\n" << toposlam::configYaml(config, false);
+      return 0;
+    }
     if (check_only) {
       if (const std::string problem = toposlam::daemon::checkSourceUri(config.source); !problem.empty())
         throw toposlam::ConfigError(config_path + ": source: " + problem);

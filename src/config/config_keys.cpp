@@ -1,0 +1,596 @@
+// The key table of toposlamd's config (see config_keys.hpp): the one place a key, its default, range,
+// unit and help are written. The defaults are those of a default-constructed DaemonConfig (stage structs
+// plus the "default" method preset); test_config_keys checks every one mechanically.
+#include "toposlam/config/config_keys.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+#include "toposlam/config/daemon_config.hpp"
+#include "toposlam/config/method_preset.hpp"
+
+namespace toposlam {
+
+namespace {
+
+// The member a key lands in, for const and non-const configs alike.
+#define AT(member) [](auto& c) -> auto& { return c.member; }
+
+// Range ends in messages and docs: the stream's default format ("0.1", "1e+06").
+std::string rangeNumber(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+ConfigKey base(std::string path, ConfigKind kind, std::string unit, std::string help) {
+  ConfigKey k;
+  k.path = std::move(path);
+  k.kind = kind;
+  k.unit = std::move(unit);
+  k.help = std::move(help);
+  return k;
+}
+
+template <typename Access>
+ConfigKey integer(std::string path, Access access, long long def, long long lo, long long hi, std::string unit,
+                  std::string help) {
+  ConfigKey k = base(std::move(path), ConfigKind::Integer, std::move(unit), std::move(help));
+  k.default_value = def;
+  k.integer_low = lo;
+  k.integer_high = hi;
+  k.low = static_cast<double>(lo);
+  k.high = static_cast<double>(hi);
+  k.get = [access](const DaemonConfig& c) -> ConfigValue { return static_cast<long long>(access(c)); };
+  k.set = [access](DaemonConfig& c, const ConfigValue& v) {
+    auto& member = access(c);
+    member = static_cast<std::remove_reference_t<decltype(member)>>(std::get<long long>(v));
+  };
+  return k;
+}
+
+template <typename Access>
+ConfigKey real(std::string path, Access access, double def, double lo, double hi, std::string unit, std::string help) {
+  ConfigKey k = base(std::move(path), ConfigKind::Real, std::move(unit), std::move(help));
+  k.default_value = def;
+  k.low = lo;
+  k.high = hi;
+  k.get = [access](const DaemonConfig& c) -> ConfigValue { return static_cast<double>(access(c)); };
+  k.set = [access](DaemonConfig& c, const ConfigValue& v) { access(c) = std::get<double>(v); };
+  return k;
+}
+
+template <typename Access>
+ConfigKey flag(std::string path, Access access, bool def, std::string help) {
+  ConfigKey k = base(std::move(path), ConfigKind::Flag, "", std::move(help));
+  k.default_value = def;
+  k.get = [access](const DaemonConfig& c) -> ConfigValue { return static_cast<bool>(access(c)); };
+  k.set = [access](DaemonConfig& c, const ConfigValue& v) { access(c) = std::get<bool>(v); };
+  return k;
+}
+
+/// A string of min_length .. max_length characters.
+template <typename Access>
+ConfigKey text(std::string path, Access access, std::string def, std::size_t min_length, std::size_t max_length,
+               std::string help) {
+  ConfigKey k = base(std::move(path), ConfigKind::Text, "", std::move(help));
+  k.default_value = std::move(def);
+  k.min_length = min_length;
+  k.max_length = max_length;
+  k.get = [access](const DaemonConfig& c) -> ConfigValue { return std::string(access(c)); };
+  k.set = [access](DaemonConfig& c, const ConfigValue& v) { access(c) = std::get<std::string>(v); };
+  return k;
+}
+
+/// One of `names`, each naming a value of the member (an enum or a string).
+template <typename Access, typename Value>
+ConfigKey choice(std::string path, Access access, Value def, std::vector<std::pair<std::string, Value>> names,
+                 std::string help) {
+  ConfigKey k = base(std::move(path), ConfigKind::Choice, "", std::move(help));
+  for (const auto& [name, value] : names) {
+    k.choices.push_back(name);
+    if (value == def) k.default_value = name;
+  }
+  k.get = [access, names](const DaemonConfig& c) -> ConfigValue {
+    for (const auto& [name, value] : names)
+      if (value == access(c)) return name;
+    return std::string("?");  // a value outside the table: problem() refuses it
+  };
+  k.set = [access, names](DaemonConfig& c, const ConfigValue& v) {
+    for (const auto& [name, value] : names)
+      if (name == std::get<std::string>(v)) access(c) = value;
+  };
+  return k;
+}
+
+template <typename Access>
+ConfigKey choice(std::string path, Access access, const std::string& def, const std::vector<std::string>& names,
+                 std::string help) {
+  std::vector<std::pair<std::string, std::string>> pairs;
+  for (const std::string& n : names) pairs.emplace_back(n, n);
+  return choice(std::move(path), access, def, pairs, std::move(help));
+}
+
+// The five keys of one pipeline thread.
+void addThread(std::vector<ConfigKey>& keys, const std::string& thread, ThreadSettings PipelineThreads::*member,
+               const std::string& def_name) {
+  const std::string p = "pipeline.threads." + thread + ".";
+  const auto at = [member](auto& c) -> auto& { return c.pipeline.threads.*member; };
+  keys.push_back(text(p + "name", [at](auto& c) -> auto& { return at(c).name; }, def_name, 1, 15,
+                      "thread name (Linux limit: 15 characters)"));
+  keys.push_back(integer(p + "cpu", [at](auto& c) -> auto& { return at(c).cpu; }, -1, -1, 1023, "",
+                         "CPU to pin the thread to").withNote("-1 = no pinning"));
+  keys.push_back(choice(p + "policy", [at](auto& c) -> auto& { return at(c).policy; }, SchedulingPolicy::Other,
+                        {{"other", SchedulingPolicy::Other}, {"fifo", SchedulingPolicy::Fifo}},
+                        "scheduling policy"));
+  keys.push_back(integer(p + "priority", [at](auto& c) -> auto& { return at(c).priority; }, 0, 0, 99, "",
+                         "SCHED_FIFO priority; one that cannot be set (no CAP_SYS_NICE / LimitRTPRIO) is logged, "
+                         "not fatal")
+                     .withNote("1 .. 99 with policy fifo, 0 with other")
+                     .withCrossCheck([at](const DaemonConfig& c) -> std::string {
+                       const ThreadSettings& t = at(c);
+                       if (t.policy == SchedulingPolicy::Fifo && (t.priority < 1 || t.priority > 99))
+                         return std::to_string(t.priority) + " is out of range for policy fifo, allowed 1 .. 99";
+                       if (t.policy == SchedulingPolicy::Other && t.priority != 0)
+                         return std::to_string(t.priority) + " is out of range for policy other, allowed 0";
+                       return "";
+                     }));
+  keys.push_back(integer(p + "nice", [at](auto& c) -> auto& { return at(c).nice; }, 0, -20, 19, "",
+                         "nice value with policy other (0 = leave as is)"));
+}
+
+std::vector<ConfigKey> makeKeys() {
+  const long long kMaxSeed = std::numeric_limits<long long>::max();
+  std::vector<ConfigKey> k;
+  // Top level.
+  k.push_back(choice("preset", AT(preset), std::string("default"), methodPresetNames(),
+                     "method preset: default (measured on real frames: docs/matching.md, docs/topology.md) or "
+                     "thesis (the published method exactly: 100 keypoints, the n-gram similarity with equal "
+                     "weights, a 25-frame window, the similarity itself as the filter's likelihood). It sets "
+                     "every stage's settings (fingerprint, similarity, segmentation, topology) first; the keys "
+                     "below override them"));
+  k.back().set = [](DaemonConfig& c, const ConfigValue& v) { applyMethodPreset(std::get<std::string>(v), c); };
+  k.push_back(text("source", AT(source), "sim:office?route=loop2", 1, 4096,
+                   "frame source URI: images:PATH_OR_GLOB (natural order), video:FILE, "
+                   "sim:WORLD?route=R&fps=F&size=WxH&seed=S, v4l2:/dev/videoN?size=WxH&fps=F&format=F, "
+                   "libcamera:ID; files take ?rate=FPS to play in real time. While a camera is absent the "
+                   "service waits for it (status \"camera reconnecting\")")
+                  .withOption("--source"));
+  k.back().example = "sim:office?route=loop2 or v4l2:/dev/video0";
+  k.push_back(choice("log_level", AT(log_level), std::string("info"), {"trace", "debug", "info", "warn", "error"},
+                     "log level. Logs go to stderr; under systemd they carry journal priorities, so "
+                     "`journalctl -u toposlamd -p warning` shows warnings and errors")
+                  .withOption("--log-level"));
+  // LCM.
+  k.push_back(text("lcm.url", AT(lcm.url), "udpm://239.255.76.67:7667?ttl=0", 1, 4096,
+                   "LCM provider URL (udpm://, mpudpm://, memq://, file:// or tcpq://). ttl=0 keeps multicast "
+                   "on this host; ttl=1 reaches the robot's LAN")
+                  .withOption("--lcm-url")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    static const char* const kProviders[] = {"udpm://", "mpudpm://", "memq://", "file://", "tcpq://"};
+                    for (const char* p : kProviders)
+                      if (c.lcm.url.rfind(p, 0) == 0) return "";
+                    return "'" + c.lcm.url +
+                           "' is not an LCM URL, expected udpm://, mpudpm://, memq://, file:// or tcpq://";
+                  }));
+  k.back().example = "udpm://239.255.76.67:7667?ttl=0";
+  k.push_back(text("lcm.channels.place", AT(lcm.place_channel), "TOPOSLAM_PLACE", 1, 255,
+                   "out: place estimate, every frame (toposlam_lcm.place_t)"));
+  k.push_back(text("lcm.channels.place_event", AT(lcm.place_event_channel), "TOPOSLAM_PLACE_EVENT", 1, 255,
+                   "out: a place was closed and mapped (place_event_t, with a JPEG thumbnail)"));
+  k.push_back(text("lcm.channels.topology", AT(lcm.topology_channel), "TOPOSLAM_TOPOLOGY", 1, 255,
+                   "out: most probable topology, when it changes (topology_t)"));
+  k.push_back(text("lcm.channels.status", AT(lcm.status_channel), "TOPOSLAM_STATUS", 1, 255,
+                   "out: pipeline status, every pipeline.status_period_s (status_t)"));
+  k.push_back(text("lcm.channels.motion", AT(lcm.motion_channel), "TOPOSLAM_MOTION", 1, 255,
+                   "in: robot motion (motion_t), counted in the status"));
+  k.push_back(integer("lcm.jpeg_quality", AT(lcm.jpeg_quality), 80, 1, 100, "", "place-event thumbnail JPEG quality"));
+  k.push_back(real("lcm.open_retry_s", AT(lcm.open_retry_s), 2.0, 0, 3600, "seconds",
+                   "no route to the multicast group yet (network not up): try again every this many seconds, "
+                   "status \"waiting for the network\"")
+                  .withNote("0 = exit 1 at once"));
+  // Map.
+  k.push_back(text("map.path", AT(pipeline.map_path), "map.tsm", 0, 4096,
+                   "the map file (MapStore format, docs/topology.md). Relative paths resolve against "
+                   "$STATE_DIRECTORY (systemd StateDirectory=toposlam: /var/lib/toposlam), else the working "
+                   "directory. \"\" = never saved")
+                  .withOption("--map"));
+  k.push_back(flag("map.load_at_start", AT(load_map_at_start), true,
+                   "resume from the map if it exists; a damaged file is moved to *.damaged-<UTC time> and "
+                   "map.tsm.prev is loaded instead")
+                  .withOption("--no-map-load", false));
+  k.push_back(flag("map.resume_other_source", AT(map_resume_other_source), false,
+                   "a map records its source (v4l2:/dev/video0, sim:office, ...); one made from another source "
+                   "is refused (exit 2) unless this is true")
+                  .withOption("--resume-other-source", true));
+  k.push_back(real("map.save_period_s", AT(pipeline.map_save_period_s), 60.0, 0, 86400, "seconds",
+                   "seconds between periodic saves")
+                  .withNote("0 = only at stop, else at least 1")
+                  .withOption("--save-period")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    const double v = c.pipeline.map_save_period_s;
+                    if (v == 0.0 || v >= 1.0) return "";
+                    return rangeNumber(v) + " is out of range, allowed 0 (only at stop) or [1, 86400] seconds";
+                  }));
+  k.push_back(real("map.max_mb", AT(map_max_mb), 256.0, 1, 65536, "MB",
+                   "a bigger map file is refused unread (the daemon does not start)"));
+  // Watchdog.
+  k.push_back(flag("watchdog.enabled", AT(watchdog), true,
+                   "ping systemd (WatchdogSec= in the unit) while the pipeline is healthy"));
+  k.push_back(real("watchdog.heartbeat_timeout_s", AT(pipeline.heartbeat_timeout_s), 5.0, 0.5, 600, "seconds",
+                   "a stage thread silent this long stops the pings"));
+  // Pipeline.
+  k.push_back(integer("pipeline.queues.frames", AT(pipeline.queues.frames), 2, 1, 1024, "frames",
+                      "capture -> fingerprint (frames hold camera buffers: keep small)"));
+  k.push_back(integer("pipeline.queues.fingerprints", AT(pipeline.queues.fingerprints), 8, 1, 1024, "frames",
+                      "fingerprint -> segmentation"));
+  k.push_back(integer("pipeline.queues.segmented", AT(pipeline.queues.segmented), 8, 1, 1024, "frames",
+                      "segmentation -> topology"));
+  k.push_back(integer("pipeline.queues.results", AT(pipeline.queues.results), 16, 1, 1024, "frames",
+                      "topology -> publisher"));
+  k.push_back(choice("pipeline.queues.overflow", AT(pipeline.queues.overflow), QueueOverflow::DropOldest,
+                     {{"drop_oldest", QueueOverflow::DropOldest}, {"block", QueueOverflow::Block}},
+                     "drop_oldest (real time: the oldest frame is dropped and counted) or block (lossless replay)")
+                  .withOption("--overflow"));
+  addThread(k, "capture", &PipelineThreads::capture, "tsl-capture");
+  addThread(k, "fingerprint", &PipelineThreads::fingerprint, "tsl-fingerprint");
+  addThread(k, "segmentation", &PipelineThreads::segmentation, "tsl-segment");
+  addThread(k, "topology", &PipelineThreads::topology, "tsl-topology");
+  addThread(k, "publisher", &PipelineThreads::publisher, "tsl-publish");
+  addThread(k, "map_writer", &PipelineThreads::map_writer, "tsl-mapsave");
+  k.push_back(real("pipeline.filter_budget_ms", AT(pipeline.filter_budget_ms), 5.0, 0.1, 1000, "milliseconds",
+                   "topology filter work per frame"));
+  k.push_back(real("pipeline.status_period_s", AT(pipeline.status_period_s), 1.0, 0.1, 60, "seconds",
+                   "status message period"));
+  k.push_back(integer("pipeline.thumbnail_width", AT(pipeline.thumbnail_width), 160, 16, 1280, "pixels",
+                      "place-event thumbnail width (the height keeps the aspect)"));
+  // Fingerprint (VpackConfig, its pool size beside it).
+  k.push_back(integer("fingerprint.workers", AT(fingerprint_workers), 2, 1, 64, "threads",
+                      "WorkerPool threads for the per-subregion work, incl. the fingerprint thread"));
+  k.push_back(real("fingerprint.edges.opening_height_fraction", AT(fingerprint.edges.opening_height_fraction), 0.2, 0,
+                   1, "", "vertical opening kernel / image height (thesis: 1/5)")
+                  .exclusive(true, false));
+  k.push_back(integer("fingerprint.edges.dilation_width", AT(fingerprint.edges.dilation_width), 3, 1, 31, "pixels",
+                      "horizontal dilation (thesis: 3)"));
+  k.push_back(real("fingerprint.edges.mean_factor", AT(fingerprint.edges.mean_factor), 5.0, 0, 100, "",
+                   "keep columns above this x the mean response (thesis: 5)")
+                  .exclusive(true, false));
+  k.push_back(real("fingerprint.edges.min_separation_fraction", AT(fingerprint.edges.min_separation_fraction), 0.05, 0,
+                   0.5, "", "non-maximum suppression half-neighbourhood / image width (thesis: 5 %)")
+                  .exclusive(true, false));
+  k.push_back(real("fingerprint.histogram.achromatic_chroma", AT(fingerprint.histogram.achromatic_chroma), 0.125, 0,
+                   1, "", "chroma at or below this is grey (thesis: 12.5 %)")
+                  .exclusive(false, true));
+  k.push_back(real("fingerprint.histogram.min_lightness", AT(fingerprint.histogram.min_lightness), 0.0, 0, 1, "",
+                   "ignore darker pixels"));
+  k.push_back(real("fingerprint.histogram.max_lightness", AT(fingerprint.histogram.max_lightness), 1.0, 0, 1, "",
+                   "ignore brighter pixels")
+                  .withNote("and > min_lightness")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    const HclHistogramConfig& h = c.fingerprint.histogram;
+                    if (h.max_lightness > h.min_lightness) return "";
+                    return rangeNumber(h.max_lightness) + " is out of range, allowed (min_lightness = " +
+                           rangeNumber(h.min_lightness) + ", 1]";
+                  }));
+  k.push_back(choice("fingerprint.keypoints.backend", AT(fingerprint.keypoints.backend), KeypointBackend::Orb,
+                     {{"orb", KeypointBackend::Orb},
+                      {"sift", KeypointBackend::Sift},
+                      {"brisk", KeypointBackend::Brisk},
+                      {"akaze", KeypointBackend::Akaze}},
+                     "keypoint detector and descriptor"));
+  k.push_back(integer("fingerprint.keypoints.max_keypoints", AT(fingerprint.keypoints.max_keypoints), 100, 0, 10000,
+                      "", "keypoints per frame (thesis: 100)"));
+  k.push_back(integer("fingerprint.keypoints.threshold_iterations", AT(fingerprint.keypoints.threshold_iterations), 8,
+                      0, 64, "", "response threshold adjustments per subregion"));
+  k.push_back(integer("fingerprint.keypoints.candidate_limit", AT(fingerprint.keypoints.candidate_limit), 1000, 0,
+                      100000, "", "the detector's own cap on candidates before selection")
+                  .withNote("and >= max_keypoints")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    const KeypointConfig& kp = c.fingerprint.keypoints;
+                    if (kp.candidate_limit >= kp.max_keypoints) return "";
+                    return std::to_string(kp.candidate_limit) + " is out of range, allowed max_keypoints (" +
+                           std::to_string(kp.max_keypoints) + ") .. 100000";
+                  }));
+  k.push_back(integer("fingerprint.keypoints.orb_levels", AT(fingerprint.keypoints.orb_levels), 6, 1, 16, "",
+                      "ORB pyramid levels (fewer is faster)"));
+  k.push_back(integer("fingerprint.keypoints.orb_fast_threshold", AT(fingerprint.keypoints.orb_fast_threshold), 12, 1,
+                      254, "", "ORB FAST floor; low so the subregions have candidates to choose from"));
+  k.push_back(integer("fingerprint.min_image_width", AT(fingerprint.min_image_width), 16, 4, 100000, "pixels",
+                      "smaller frames are skipped (counted)"));
+  k.push_back(integer("fingerprint.min_image_height", AT(fingerprint.min_image_height), 16, 4, 100000, "pixels",
+                      "smaller frames are skipped (counted)"));
+  // Similarity (NgramSimilarityConfig).
+  k.push_back(real("similarity.matcher.max_hellinger_distance", AT(similarity.matcher.max_hellinger_distance), 0.3, 0,
+                   1, "", "histograms match at most this normalised Hellinger distance apart (thesis: 0.3)")
+                  .exclusive(true, false));
+  k.push_back(real("similarity.matcher.max_binary_distance_fraction",
+                   AT(similarity.matcher.max_binary_distance_fraction), 0.25, 0, 1, "",
+                   "binary descriptors: most Hamming distance of a kept match, as a fraction of the bits")
+                  .exclusive(true, false)
+                  .withNote("1 disables the test"));
+  k.push_back(real("similarity.matcher.max_float_distance", AT(similarity.matcher.max_float_distance), 0.0, 0, 1e6, "",
+                   "float descriptors (SIFT): most L2 distance of a kept match")
+                  .withNote("0 disables the test"));
+  k.push_back(real("similarity.matcher.ratio_test", AT(similarity.matcher.ratio_test), 0.8, 0, 1, "",
+                   "Lowe's ratio test: kept when best <= this x second best")
+                  .exclusive(true, false)
+                  .withNote("1 disables the test"));
+  k.push_back(flag("similarity.matcher.mutual_check", AT(similarity.matcher.mutual_check), true,
+                   "keep a match only when it is mutual"));
+  k.push_back(real("similarity.matcher.max_angle_difference_deg", AT(similarity.matcher.max_angle_difference_deg), 25,
+                   0, 180, "degrees", "orientation check: most difference of the two keypoints' orientations")
+                  .withNote("0 disables the test"));
+  k.push_back(real("similarity.histogram_weight", AT(similarity.histogram_weight), 0.05, 0, 1, "",
+                   "weight of the histogram part; the keypoint part gets 1 - this"));
+  k.push_back(flag("similarity.histogram_gate", AT(similarity.histogram_gate), false,
+                   "histograms scale the keypoint part instead of adding to it"));
+  k.push_back(flag("similarity.histogram_only_fallback", AT(similarity.histogram_only_fallback), false,
+                   "a reference without keypoints is scored by its histograms alone"));
+  k.push_back(choice("similarity.keypoint_scoring", AT(similarity.keypoint_scoring), KeypointScoring::VerifiedMatches,
+                     {{"possible-ngrams", KeypointScoring::PossibleNgrams},
+                      {"verified-matches", KeypointScoring::VerifiedMatches}},
+                     "how the keypoint part is scored (docs/matching.md)"));
+  // Segmentation (FiedlerSegmenterConfig, MotionGateConfig).
+  k.push_back(real("segmentation.window_s", AT(segmentation.window_s), 6.0, 0, 3600, "seconds",
+                   "sliding window in seconds, from frame timestamps")
+                  .withNote("0 = `window` frames"));
+  k.push_back(integer("segmentation.window", AT(segmentation.window), 100, 3, 1000, "frames",
+                      "frames in the window with window_s 0, else the most the window holds"));
+  k.push_back(integer("segmentation.min_window_frames", AT(segmentation.min_window_frames), 5, 3, 1000, "frames",
+                      "fewest frames a window in seconds (or metres) keeps")
+                  .withNote("and <= window")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    if (c.segmentation.min_window_frames <= c.segmentation.window) return "";
+                    return std::to_string(c.segmentation.min_window_frames) + " is out of range, allowed 3 .. window (" +
+                           std::to_string(c.segmentation.window) + ") frames";
+                  }));
+  k.push_back(real("segmentation.window_m", AT(segmentation.window_m), 0.0, 0, 1000, "metres",
+                   "with robot motion known (TOPOSLAM_MOTION): the window spans this much travel instead of "
+                   "window_s (thesis 1.5 .. 1.75; 3 measured best on the simulated office, docs/segmentation.md)")
+                  .withNote("0 = off: no window in distance"));
+  k.push_back(real("segmentation.min_frame_spacing_m", AT(segmentation.min_frame_spacing_m), 0.09, 0, 100, "metres",
+                   "with motion and window_m > 0: leave out a frame closer than this to the last one added, in "
+                   "travel and in heading, so a slow stretch does not cut extra places")
+                  .withNote("0 = off"));
+  k.push_back(real("segmentation.min_frame_spacing_rad", AT(segmentation.min_frame_spacing_rad), 0.03, 0, 10, "rad",
+                   "the heading part of min_frame_spacing_m"));
+  k.push_back(real("segmentation.similarity_floor", AT(segmentation.similarity_floor), 0.0, 0, 1, "",
+                   "subtracted from every similarity before it enters the affinity matrix (clamped at 0), so "
+                   "frames of different places that still match by colour become unlinked")
+                  .exclusive(false, true));
+  k.push_back(real("segmentation.motion.standing_speed_mps", AT(segmentation_motion.standing_speed_mps), 0.05, 0, 10,
+                   "m/s", "slower than this counts as standing"));
+  k.push_back(real("segmentation.motion.standing_turn_rate_rps", AT(segmentation_motion.standing_turn_rate_rps), 0.1,
+                   0, 100, "rad/s", "... unless turning faster than this"));
+  k.push_back(real("segmentation.motion.standing_after_s", AT(segmentation_motion.standing_after_s), 1.0, 0, 3600,
+                   "seconds", "standing once slow for this long"));
+  k.push_back(real("segmentation.motion.timeout_s", AT(segmentation_motion.timeout_s), 1.0, 0, 3600, "seconds",
+                   "motion is known while the newest sample is at most this old")
+                  .exclusive(true, false));
+  k.push_back(real("segmentation.valley.gamma", AT(segmentation.valley.gamma), 0.5, 0, 2, "",
+                   "peak height on the lambda2 scale (thesis: 0.5)")
+                  .withNote("and <= window / (window - 1)")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    const double max = maxFiedlerValue(c.segmentation.window);
+                    if (c.segmentation.valley.gamma <= max) return "";
+                    return rangeNumber(c.segmentation.valley.gamma) +
+                           " is out of range, allowed [0, window / (window - 1) = " + rangeNumber(max) + "]";
+                  }));
+  k.push_back(real("segmentation.valley.delta", AT(segmentation.valley.delta), 0.30, 0, 2, "",
+                   "rise and fall between peak and valley")
+                  .withNote("and <= gamma")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    if (c.segmentation.valley.delta <= c.segmentation.valley.gamma) return "";
+                    return rangeNumber(c.segmentation.valley.delta) + " is out of range, allowed [0, gamma = " +
+                           rangeNumber(c.segmentation.valley.gamma) + "]";
+                  }));
+  k.push_back(integer("segmentation.min_keypoints", AT(segmentation.min_keypoints), 15, 0, 10000, "",
+                      "places whose representative has fewer keypoints are dropped (thesis: 15)"));
+  k.push_back(choice("segmentation.cut_placement", AT(segmentation.cut_placement), CutPlacement::WindowSplit,
+                     {{"window-split", CutPlacement::WindowSplit}, {"valley-frame", CutPlacement::ValleyFrame}},
+                     "where a place ends: the best split of the valley's window, or the valley frame (thesis)"));
+  // Topology (TopologyFilterConfig, the stage's slicing beside it).
+  k.push_back(integer("topology.particles", AT(topology.particles), 500, 1, 1000000, "",
+                      "particles over topologies (thesis: 500)"));
+  k.push_back(choice("topology.likelihood", AT(topology.likelihood), LikelihoodModel::Relative,
+                     {{"relative", LikelihoodModel::Relative}, {"absolute", LikelihoodModel::Absolute}},
+                     "relative (per query, docs/topology.md) or absolute (the similarity itself, thesis)"));
+  k.push_back(real("topology.relative_slope", AT(topology.relative_slope), 2.0, 0, 100, "",
+                   "relative likelihood: logistic slope per z unit")
+                  .exclusive(true, false));
+  k.push_back(real("topology.relative_offset", AT(topology.relative_offset), 8.0, -10, 10, "",
+                   "relative likelihood: z (leave-one-out, among the stored representatives) at likelihood 1/2"));
+  k.push_back(real("topology.relative_sigma_floor", AT(topology.relative_sigma_floor), 0.02, 0, 1, "",
+                   "relative likelihood: smallest spread of the other similarities")
+                  .exclusive(true, false));
+  k.push_back(real("topology.alpha", AT(topology.alpha), 15.0, 0, 1e6, "", "expected number of places (thesis: 15)")
+                  .exclusive(true, false));
+  k.push_back(real("topology.new_node_probability", AT(topology.new_node_probability), 0.05, 0, 1, "",
+                   "probability of a new node from a known one (thesis: 0.05)")
+                  .exclusive(true, true));
+  k.push_back(real("topology.gamma_shape", AT(topology.gamma_shape), 5.0, 0, 1000, "",
+                   "successor gamma pdf shape (5 and scale 0.4 give staying 0.33, docs/topology.md)")
+                  .exclusive(true, false));
+  k.push_back(real("topology.gamma_scale", AT(topology.gamma_scale), 0.4, 0, 100, "",
+                   "successor gamma pdf scale")
+                  .exclusive(true, false));
+  k.push_back(integer("topology.max_successors", AT(topology.max_successors), 5, 1, kTopologyMaxSuccessors, "",
+                      "successors proposed from a known node"));
+  k.push_back(integer("topology.max_representatives_per_node", AT(topology.max_representatives_per_node), 8, 1,
+                      kTopologyMaxRepresentatives, "", "representatives kept per node and particle, oldest dropped"));
+  k.push_back(flag("topology.forbid_return_to_previous", AT(topology.forbid_return_to_previous), false,
+                   "also drop the node visited just before the current one from the successor candidates"));
+  k.push_back(integer("topology.seed", AT(topology.seed), 1, 0, kMaxSeed, "",
+                      "seed of the filter's random generator (runs replay bit for bit)"));
+  // Sequence evidence (SequenceEvidenceConfig; docs/topology.md "Sequence evidence in the filter").
+  k.push_back(real("topology.sequence_evidence.weight", AT(sequence_evidence.weight), 0.0, 0, 1, "",
+                   "likelihood of an earlier place every keyframe of a new place detects into; 0 = off (it closes "
+                   "look-alike stretches of one lap), 0.99 = on"));
+  k.push_back(real("topology.sequence_evidence.min_share", AT(sequence_evidence.min_share), 0.8, 0, 1, "",
+                   "share of a new place's keyframes an earlier place needs before it gets evidence"));
+  k.push_back(real("topology.sequence_evidence.min_score", AT(sequence_evidence.min_score), 0.1, 0, 1e6, "",
+                   "detection score D (integrated relative similarity) a keyframe needs to count"));
+  k.push_back(real("topology.sequence_evidence.min_relative", AT(sequence_evidence.min_relative), 0.0, -1e6, 1e6, "",
+                   "the keyframe's own relative similarity z with its detection needed to count"));
+  k.push_back(real("topology.sequence_evidence.keyframe_interval_s", AT(sequence_evidence.loop.keyframe_interval_s), 1.0,
+                   0, 1e6, "s", "one keyframe at most this often"));
+  k.push_back(real("topology.sequence_evidence.decay", AT(sequence_evidence.loop.decay), 0.975, 0, 1, "",
+                   "evidence kept per keyframe along a diagonal")
+                  .exclusive(false, true));
+  k.push_back(integer("topology.sequence_evidence.min_gap_keyframes", AT(sequence_evidence.loop.min_gap_keyframes), 20,
+                      1, 1000000, "keyframes", "detections at least this many keyframes back"));
+  k.push_back(integer("topology.slice_items", AT(topology_slice_items), 256, 1, 1000000, "work items",
+                      "work items per advance() slice (the time budget is checked between slices)"));
+  k.push_back(integer("topology.alternatives", AT(topology_alternatives), 3, 0, 16, "nodes",
+                      "other nodes published with each place estimate"));
+  return k;
+}
+
+#undef AT
+
+}  // namespace
+
+std::string ConfigKey::rangeText() const {
+  std::string range;
+  switch (kind) {
+    case ConfigKind::Integer:
+      range = std::to_string(integer_low) + " .. " + std::to_string(integer_high);
+      break;
+    case ConfigKind::Real:
+      range = std::string(low_open ? "(" : "[") + rangeNumber(low) + ", " + rangeNumber(high) + (high_open ? ")" : "]");
+      break;
+    case ConfigKind::Flag:
+      range = "true or false";
+      break;
+    case ConfigKind::Text:
+      range = std::to_string(min_length) + " to " + std::to_string(max_length) + " characters";
+      break;
+    case ConfigKind::Choice:
+      for (const std::string& c : choices) range += (range.empty() ? "one of: " : ", ") + c;
+      break;
+  }
+  if (!unit.empty()) range += " " + unit;
+  if (!note.empty()) range += " (" + note + ")";
+  return range;
+}
+
+std::string ConfigKey::problem(const ConfigValue& value) const {
+  switch (kind) {
+    case ConfigKind::Integer: {
+      const long long v = std::get<long long>(value);
+      if (v >= integer_low && v <= integer_high) return "";
+      return std::to_string(v) + " is out of range, allowed " + rangeText();
+    }
+    case ConfigKind::Real: {
+      const double v = std::get<double>(value);
+      const bool inside =
+          std::isfinite(v) && (low_open ? v > low : v >= low) && (high_open ? v < high : v <= high);
+      if (inside) return "";
+      return rangeNumber(v) + " is out of range, allowed " + rangeText();
+    }
+    case ConfigKind::Flag:
+      return "";
+    case ConfigKind::Text: {
+      const std::string& v = std::get<std::string>(value);
+      if (v.size() >= min_length && v.size() <= max_length) return "";
+      if (v.empty() && !example.empty()) return "must not be empty (e.g. " + example + ")";
+      return "must have " + std::to_string(min_length) + " to " + std::to_string(max_length) + " characters, got '" +
+             v + "'";
+    }
+    case ConfigKind::Choice: {
+      const std::string& v = std::get<std::string>(value);
+      for (const std::string& c : choices)
+        if (c == v) return "";
+      std::string list;
+      for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
+      return "'" + v + "' is not allowed, expected one of: " + list;
+    }
+  }
+  return "";
+}
+
+std::string ConfigKey::yamlText(const ConfigValue& value) const {
+  switch (kind) {
+    case ConfigKind::Integer:
+      return std::to_string(std::get<long long>(value));
+    case ConfigKind::Real: {
+      char buffer[64];
+      const auto result = std::to_chars(buffer, buffer + sizeof buffer, std::get<double>(value));
+      std::string text(buffer, result.ptr);
+      // A real reads as a real: "5" would too, but "5.0" says what the key is; "1e+06" reads back exactly.
+      if (text.find_first_of(".en") == std::string::npos) text += ".0";
+      return text;
+    }
+    case ConfigKind::Flag:
+      return std::get<bool>(value) ? "true" : "false";
+    case ConfigKind::Choice:
+      return std::get<std::string>(value);
+    case ConfigKind::Text: {
+      std::string quoted = "\"";
+      for (const char ch : std::get<std::string>(value)) {
+        if (ch == '"' || ch == '\\') quoted += '\\';
+        quoted += ch;
+      }
+      return quoted + "\"";
+    }
+  }
+  return "";
+}
+
+double ConfigKey::defaultNumber() const {
+  if (kind == ConfigKind::Integer) return static_cast<double>(std::get<long long>(default_value));
+  if (kind == ConfigKind::Real) return std::get<double>(default_value);
+  throw std::logic_error("config key " + path + " is not a number");
+}
+
+const std::vector<ConfigKey>& daemonConfigKeys() {
+  static const std::vector<ConfigKey> keys = makeKeys();
+  return keys;
+}
+
+const std::vector<ConfigSection>& daemonConfigSections() {
+  static const std::vector<ConfigSection> sections = {
+      {"lcm", "LCM transport and channel names"},
+      {"lcm.channels", "channel names, 1 .. 255 characters each"},
+      {"map", "the map file: where, when it is saved, whether it is resumed"},
+      {"watchdog", "systemd watchdog"},
+      {"pipeline", "queues, threads and time budgets of the daemon's pipeline (docs/daemon.md)"},
+      {"pipeline.queues", "queue capacities between the stage threads"},
+      {"pipeline.threads", "per thread: name, CPU pinning, scheduling policy, priority, nice"},
+      {"pipeline.threads.capture", "reads frames from the source"},
+      {"pipeline.threads.fingerprint", "fingerprints frames (with fingerprint.workers - 1 pool threads)"},
+      {"pipeline.threads.segmentation", "segments the stream into places"},
+      {"pipeline.threads.topology", "runs the particle filter over topologies"},
+      {"pipeline.threads.publisher", "publishes over LCM"},
+      {"pipeline.threads.map_writer", "writes map snapshots (fsync off the frame path)"},
+      {"fingerprint", "VPACK fingerprint (thesis ch. 3, docs/fingerprint.md)"},
+      {"fingerprint.edges", "vertical edges"},
+      {"fingerprint.histogram", "HCL colour histograms"},
+      {"fingerprint.keypoints", "keypoints per subregion"},
+      {"similarity", "n-gram similarity (thesis ch. 3.3, docs/matching.md)"},
+      {"similarity.matcher", "which keypoint and histogram matches count"},
+      {"segmentation", "Fiedler segmentation (thesis ch. 4, docs/segmentation.md)"},
+      {"segmentation.motion",
+       "motion-aware segmentation (docs/segmentation.md): with robot motion known (TOPOSLAM_MOTION), frames "
+       "taken while the robot stands are left out of the window; without motion, or once the link is lost, "
+       "segmentation is by time"},
+      {"segmentation.valley", "valley detector on lambda2 (Algorithm 4.1)"},
+      {"topology", "particle filter over topologies (thesis ch. 5, docs/topology.md)"},
+      {"topology.sequence_evidence",
+       "runs of frames as the filter's second evidence (docs/topology.md, \"Sequence evidence in the filter\")"},
+  };
+  return sections;
+}
+
+const ConfigKey& daemonConfigKey(std::string_view path) {
+  for (const ConfigKey& key : daemonConfigKeys())
+    if (key.path == path) return key;
+  throw std::out_of_range("no config key '" + std::string(path) + "'");
+}
+
+}  // namespace toposlam

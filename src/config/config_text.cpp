@@ -1,0 +1,168 @@
+// Texts made from the config key table: see config_text.hpp.
+#include "toposlam/config/config_text.hpp"
+
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "toposlam/config/config_keys.hpp"
+#include "toposlam/config/daemon_config.hpp"
+
+namespace toposlam {
+
+namespace {
+
+constexpr std::size_t kLineWidth = 110;
+
+// `text` as comment lines starting with `prefix` ("  # "), broken between words before kLineWidth.
+std::string commentLines(const std::string& prefix, const std::string& text) {
+  std::string out, line = prefix;
+  std::istringstream words(text);
+  for (std::string word; words >> word;) {
+    if (line.size() > prefix.size() && line.size() + 1 + word.size() > kLineWidth) {
+      out += line + "\n";
+      line = prefix;
+    }
+    line += (line.size() > prefix.size() ? " " : "") + word;
+  }
+  return out + line + "\n";
+}
+
+std::string sectionHelp(const std::string& path) {
+  for (const ConfigSection& s : daemonConfigSections())
+    if (s.path == path) return s.help;
+  return "";
+}
+
+// The section part of a key path ("a.b" of "a.b.c"; "" at the top level).
+std::string sectionOf(const std::string& path) {
+  const std::size_t dot = path.rfind('.');
+  return dot == std::string::npos ? "" : path.substr(0, dot);
+}
+
+std::vector<std::string> split(const std::string& path) {
+  std::vector<std::string> parts;
+  std::size_t begin = 0;
+  for (std::size_t dot; (dot = path.find('.', begin)) != std::string::npos; begin = dot + 1)
+    parts.push_back(path.substr(begin, dot - begin));
+  if (!path.empty()) parts.push_back(path.substr(begin));
+  return parts;
+}
+
+DaemonConfig thesisConfig() {
+  DaemonConfig thesis;
+  applyMethodPreset("thesis", thesis);
+  return thesis;
+}
+
+// A key's comment: its help, its allowed values and the thesis preset's value where it differs.
+std::string keyComment(const ConfigKey& key, const DaemonConfig& thesis) {
+  std::string comment = key.help;
+  if (key.kind != ConfigKind::Flag) comment += "; allowed " + key.rangeText();
+  const ConfigValue thesis_value = key.get(thesis);
+  if (key.path != "preset" && thesis_value != key.default_value)
+    comment += "; thesis preset " + key.yamlText(thesis_value);
+  return comment;
+}
+
+}  // namespace
+
+std::string configYaml(const DaemonConfig& config, bool comments) {
+  const DaemonConfig thesis = thesisConfig();
+  std::string out;
+  std::vector<std::string> open;  // the sections the previous key was in
+  std::set<std::string> explained;
+  for (const ConfigKey& key : daemonConfigKeys()) {
+    const std::vector<std::string> sections = split(sectionOf(key.path));
+    std::size_t common = 0;
+    while (common < open.size() && common < sections.size() && open[common] == sections[common]) ++common;
+    open.resize(common);
+    for (std::size_t depth = common; depth < sections.size(); ++depth) {
+      const std::string indent(2 * depth, ' ');
+      open.push_back(sections[depth]);
+      std::string path;
+      for (const std::string& s : open) path += (path.empty() ? "" : ".") + s;
+      if (depth == 0) out += "\n";
+      if (comments && !sectionHelp(path).empty()) out += commentLines(indent + "# ", sectionHelp(path));
+      out += indent + sections[depth] + ":\n";
+    }
+    const std::string indent(2 * sections.size(), ' ');
+    if (comments) {
+      if (sections.empty()) out += "\n";
+      // The threads' five keys are explained once, at the first thread.
+      const std::string comment = keyComment(key, thesis);
+      const std::string grandparent = sectionOf(sectionOf(key.path));
+      if (explained.insert(grandparent + "|" + split(key.path).back() + "|" + comment).second)
+        out += commentLines(indent + "# ", comment);
+    }
+    const std::vector<std::string> parts = split(key.path);
+    out += indent + parts.back() + ": " + key.yamlText(key.get(config)) + "\n";
+  }
+  return out;
+}
+
+std::string shippedConfigYaml() {
+  DaemonConfig shipped;
+  shipped.source = kShippedSource;
+  return "# toposlam.yaml: the one config of toposlamd (installed as /etc/toposlam/toposlam.yaml; with systemd,\n"
+         "# ConfigurationDirectory=toposlam makes it $CONFIGURATION_DIRECTORY/toposlam.yaml).\n"
+         "#\n"
+         "# Made by `toposlam config --shipped` from the key table (src/config/config_keys.cpp); test_config_keys\n"
+         "# checks that this file is what the table makes, so change a key's help or default there.\n"
+         "# Every key is optional: an absent key keeps the default shown here (the built-in defaults are the\n"
+         "# same, except `source`: the camera here, the simulator sim:office?route=loop2 without a config file).\n"
+         "# `preset` comes first: it sets every stage's settings (fingerprint, similarity, segmentation,\n"
+         "# topology) and the keys below override them; the values shown are the \"default\" preset's.\n"
+         "# Unknown or repeated keys, wrong types and out-of-range values are refused at start, with the key's\n"
+         "# full dotted name and its allowed range, e.g.\n"
+         "#   toposlamd: error: /etc/toposlam/toposlam.yaml: pipeline.queues.frames: 0 is out of range, allowed 1 .. 1024 frames\n"
+         "# Check a file without starting: toposlamd --check-config -c FILE; every key's effective value:\n"
+         "# toposlamd --print-config -c FILE. All keys, with the thesis preset's values: docs/config.md.\n" +
+         configYaml(shipped, true);
+}
+
+std::string configDocsMarkdown() {
+  const DaemonConfig thesis = thesisConfig();
+  std::string out =
+      "# Config keys of toposlamd\n"
+      "\n"
+      "<!-- Made by `toposlam config --docs` from the key table (src/config/config_keys.cpp); test_config_keys\n"
+      "     checks that this file is what the table makes. Edit the table, then regenerate. -->\n"
+      "\n"
+      "Every key of `config/toposlam.yaml`, with its default (the built-in value, which is the `default`\n"
+      "method preset's), the `thesis` preset's value where it differs, the values allowed, the `toposlamd`\n"
+      "option that overrides it and what it does. `preset` is read first and sets every stage's settings;\n"
+      "the other keys override them. `toposlamd --print-config [-c FILE]` (or `toposlam config --print\n"
+      "[-c FILE]`) shows the effective value of every key; `toposlamd --check-config -c FILE` validates a\n"
+      "file. How the file is read and refused: [daemon.md](daemon.md#config).\n"
+      "\n"
+      "A key is added with one entry in `makeKeys()` of src/config/config_keys.cpp (path, member, default,\n"
+      "range, unit, help); the reader, validation, `--print-config`, the shipped file and this page follow.\n";
+  std::string section = "-";
+  for (const ConfigKey& key : daemonConfigKeys()) {
+    const std::string top = split(key.path).size() > 1 ? split(key.path).front() : "";
+    if (top != section) {
+      section = top;
+      out += "\n## " + (top.empty() ? std::string("Top level") : "`" + top + "`") + "\n\n";
+      if (!sectionHelp(top).empty()) out += sectionHelp(top) + ".\n\n";
+      out += "| key | default | thesis | allowed | option | what it does |\n";
+      out += "|---|---|---|---|---|---|\n";
+    }
+    const ConfigValue thesis_value = key.get(thesis);
+    std::string thesis_text;
+    if (key.path != "preset" && thesis_value != key.default_value) thesis_text = "`" + key.yamlText(thesis_value) + "`";
+    std::string help;  // a '|' would end the table cell
+    for (const char ch : key.help) {
+      if (ch == '|') help += '\\';
+      help += ch;
+    }
+    const std::string allowed = key.kind == ConfigKind::Flag ? std::string("true, false") : key.rangeText();
+    std::string option;
+    if (!key.option.empty()) option = "`" + key.option + "`";
+    out += "| `" + key.path + "` | `" + key.yamlText(key.default_value) + "` | ";
+    out += thesis_text + " | " + allowed + " | " + option + " | " + help + " |\n";
+  }
+  return out;
+}
+
+}  // namespace toposlam
