@@ -238,6 +238,7 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     p.real("filter_budget_ms", c.pipeline.filter_budget_ms, 0.1, 1000, " milliseconds");
     p.real("status_period_s", c.pipeline.status_period_s, 0.1, 60, " seconds");
     p.integer("thumbnail_width", c.pipeline.thumbnail_width, 16, 1280, " pixels");
+    p.integer("opencv_threads", c.pipeline.opencv_threads, 0, 64, " threads");
     p.finish();
   }
   {
@@ -344,6 +345,12 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     t.integer("seed", c.topology.seed, 0, std::numeric_limits<long long>::max());
     t.integer("slice_items", c.topology_slice_items, 1, 1000000, " work items");
     t.integer("alternatives", c.topology_alternatives, 0, 16, " nodes");
+    // Large maps (docs/topology.md): compare a new place exhaustively up to this many stored ones.
+    Section cs = t.child("candidates");
+    cs.integer("exhaustive_up_to", c.topology.candidates.exhaustive_up_to, 0, 1000000000, " stored representatives");
+    cs.integer("candidates", c.topology.candidates.candidates, 1, 100000, " representatives");
+    cs.integer("background_samples", c.topology.candidates.background_samples, 0, 100000, " representatives");
+    cs.finish();
     t.finish();
   }
   top.finish();

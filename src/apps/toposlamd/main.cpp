@@ -39,10 +39,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
   std::string source, map_path, lcm_url, overflow;
-  bool check_only = false, no_load = false, bench = false, resume_other_source = false;
+  bool check_only = false, no_load = false, resume_other_source = false;
   std::string log_level;
   double save_period = -1.0;
-  toposlam::daemon::BenchOptions bench_options;
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml). Default: " +
                                                  toposlam::defaultDaemonConfigPath() + " if it exists, else built-in defaults");
   app.add_option("--source", source, "override `source` (e.g. sim:office?route=loop2, images:DIR, v4l2:/dev/video0)");
@@ -57,8 +56,6 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "override `log.level`: trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
-  app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
-  app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -98,10 +95,6 @@ int main(int argc, char** argv) {
     }
     spdlog::info("toposlamd: config {}; logging at {} to {}", config_path, config.log_level,
                  journal ? "the journal (priorities, no timestamps)" : "stderr");
-    if (bench) {
-      bench_options.source = config.source;
-      return toposlam::daemon::runBench(config, bench_options);
-    }
     return toposlam::daemon::runDaemon(config);
   } catch (const toposlam::ConfigError& e) {
     return startError(e, 2);
