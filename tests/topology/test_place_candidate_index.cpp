@@ -158,10 +158,10 @@ double tagTable(int a, int b) {
   return 0.08 * static_cast<double>(h % 1000) / 1000.0;
 }
 
+/// Where the robot is: the founding observation of the most probable current node over the particles.
 int decisionOf(const TopologyParticleFilter& filter) {
   const TopologyEstimate e = filter.estimate(0);
-  const auto& a = e.best.assignment;
-  return static_cast<int>(std::find(a.begin(), a.end(), e.current_node) - a.begin());
+  return e.locations.empty() ? -1 : e.locations.front().founding_observation;
 }
 
 std::string stateBytes(const TopologyParticleFilter& filter) {
@@ -211,30 +211,37 @@ TEST_CASE("GIVEN a map above exhaustive_up_to WHEN a place is revisited THEN onl
     config.relative_offset = 3.0;
     config.candidates.exhaustive_up_to = 20;
     config.candidates.candidates = 5;
-    config.candidates.background_samples = 10;
+    config.candidates.background_samples = 30;
     TopologyParticleFilter indexed(config, indexed_sim);
     config.candidates.exhaustive_up_to = 1000000000;
     TopologyParticleFilter exhaustive(config, exhaustive_sim);
     std::uint64_t noise = 1;
-    int same = 0;
+    int same = 0, closed_indexed = 0, closed_exhaustive = 0;
     for (int p : loopRoute()) {
       const auto f = placeFingerprint(p, 12, noise++);
       indexed.step(f);
       exhaustive.step(f);
       // The decision: where the robot is (the founding observation of the most probable current node).
       same += decisionOf(indexed) == decisionOf(exhaustive) ? 1 : 0;
-      if (indexed.indexedSteps() > 0) CHECK(indexed.lastStepComparisons() <= 5 + 10);
+      const int k = indexed.observationCount() - 1;
+      if (k >= 65) {
+        closed_indexed += decisionOf(indexed) == k - 60 ? 1 : 0;
+        closed_exhaustive += decisionOf(exhaustive) == k - 60 ? 1 : 0;
+      }
+      if (indexed.indexedSteps() > 0) CHECK(indexed.lastStepComparisons() <= 5 + 30);
     }
     INFO("likelihood model " << toString(model));
     // Not every step: the filters are stochastic, a slightly different weight resamples other particles.
-    CHECK(same >= 86);  // of 90 (measured: 90 relative, 89 absolute)
+    CHECK(same >= 85);  // of 90 (measured: 87 absolute, 90 relative)
     CHECK(indexed.indexedSteps() == 90 - 21);  // from the 22nd step on (21 stored > 20)
     CHECK(indexed.memoryStats().candidate_index_bytes > 0);
-    // The revisits closed the loop: once under way (a few steps), the second pass maps onto the first's nodes.
-    const std::vector<int> best = indexed.estimate(0).best.assignment;
-    for (int k = 65; k < 90; ++k) CHECK(best[static_cast<std::size_t>(k)] == best[static_cast<std::size_t>(k - 60)]);
+    // The revisits closed the loop: once under way, the robot is placed at the first pass' node.
+    CHECK(closed_indexed >= 18);  // of 25 (measured: 20 absolute, 24 relative; exhaustive 23 and 24)
+    CHECK(closed_exhaustive >= 18);
   }
-  CHECK(indexed_sim.calls() < exhaustive_sim.calls() / 2);
+  // Per model: exhaustive, 0 + 1 + ... + 89 comparisons; indexed, 0 + ... + 20, then at most 5 + 30 per step.
+  CHECK(exhaustive_sim.calls() == 2 * 4005);
+  CHECK(indexed_sim.calls() <= 2 * (210 + 69 * 35));
 }
 
 TEST_CASE("GIVEN a fork of the filter WHEN both take the same step THEN their states are identical, and the "

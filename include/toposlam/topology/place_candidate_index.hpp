@@ -30,7 +30,7 @@ namespace toposlam {
 
 struct PlaceCandidateIndexConfig {
   int tables = 8;               ///< hash tables; allowed [1, 32]
-  int bits_per_key = 16;        ///< sampled descriptor bits per key; allowed [4, 20], tables x 2^bits <= 2^21
+  int bits_per_key = 14;        ///< sampled descriptor bits per key; allowed [4, 20], tables x 2^bits <= 2^21
   double crowded_share = 0.05;  ///< a key holding more entries than this share of places is skipped; (0, 1]
   std::uint64_t seed = 1;       ///< of the bit positions
   /// "" when valid, else "<key>: <problem, allowed range>".

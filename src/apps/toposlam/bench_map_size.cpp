@@ -11,11 +11,13 @@
 //
 // Every --compare-every steps the filter is forked (shared state, TopologyParticleFilter::fork) and the
 // fork takes the same step exhaustively: the decision (the founding observation of the most probable
-// node) is compared with the indexed step's. Timings are the indexed filter's steps only; RSS is the
+// current node over the particles) is compared with the indexed step's, over all compared steps and over
+// those where the exhaustive filter has decided (its most probable node has p >= 0.5). Timings are the indexed filter's steps only; RSS is the
 // process's (VmRSS) at each checkpoint. Prints numbers (and an SVG with --svg), fails nothing.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -85,12 +87,12 @@ std::shared_ptr<const Fingerprint> observationOf(const Fingerprint& prototype, s
   return f;
 }
 
-/// Founding observation of the most probable node (-1 before the first step).
+/// The decision: where the robot is, as the most probable current node over all particles (its founding
+/// observation; -1 before the first step). Not the node in the single most probable topology, which
+/// near-ties among many similar topologies make flip with any difference in the weights.
 int decisionOf(const TopologyParticleFilter& filter) {
   const TopologyEstimate e = filter.estimate(0);
-  if (e.current_node < 0) return -1;
-  const auto& a = e.best.assignment;
-  return static_cast<int>(std::find(a.begin(), a.end(), e.current_node) - a.begin());
+  return e.locations.empty() ? -1 : e.locations.front().founding_observation;
 }
 
 struct Checkpoint {
@@ -99,6 +101,7 @@ struct Checkpoint {
   TimingSummary step;
   double rss_mb = 0, index_mb = 0;
   int compared = 0, agreed = 0;
+  int confident = 0, confident_agreed = 0;  ///< steps where the exhaustive decision has p >= 0.5
 };
 
 void runMapSizeBench(const MapSizeBenchOptions& o) {
@@ -140,15 +143,18 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   };
 
   std::vector<Checkpoint> checkpoints;
-  std::vector<double> window_ms, step_x, step_ms, rss_x, rss_mb;
+  // The plot: per 1 % of the run, the median and p99 ms of its steps and the resident MB at its end.
+  const int plot_every = std::max(1, o.places / 100);
+  std::vector<double> window_ms, plot_window_ms, plot_x, plot_median, plot_p99, plot_rss;
   int compared = 0, agreed = 0, window_compared = 0, window_agreed = 0;
+  int confident = 0, confident_agreed = 0, window_confident = 0, window_confident_agreed = 0;
   if (!o.json)
     std::printf("map-size: %d steps, %d particles, %zu donor frames of %s; exhaustive up to %d stored, then %d "
                 "candidates + %d background samples; decisions compared every %d steps\n%8s %8s %10s %10s %10s "
-                "%8s %9s %14s\n",
+                "%8s %9s %14s %14s\n",
                 o.places, o.particles, donors.size(), o.samples.c_str(), o.candidates.exhaustive_up_to,
                 o.candidates.candidates, o.candidates.background_samples, o.compare_every, "steps", "stored",
-                "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "same decision");
+                "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "same decision", "when p >= 0.5");
   for (int k = 0; k < o.places; ++k) {
     const auto observation = observationOf(prototype(route[static_cast<std::size_t>(k)]), rng);
     std::unique_ptr<TopologyParticleFilter> shadow;
@@ -160,13 +166,32 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
     filter.step(observation);
     const double ms = watch.elapsedMs();
     window_ms.push_back(ms);
-    step_x.push_back(k + 1);
-    step_ms.push_back(ms);
+    plot_window_ms.push_back(ms);
+    if ((k + 1) % plot_every == 0) {
+      const TimingSummary s = summarize(plot_window_ms);
+      plot_x.push_back(k + 1);
+      plot_median.push_back(s.median_ms);
+      plot_p99.push_back(s.p99_ms);
+      plot_rss.push_back(static_cast<double>(residentBytes()) / (1024.0 * 1024.0));
+      plot_window_ms.clear();
+    }
     if (shadow) {
       shadow->step(observation);
       const bool same = decisionOf(*shadow) == decisionOf(filter);
+      if (!same && std::getenv("TOPOSLAM_DEBUG_MAPSIZE")) {
+        const TopologyEstimate a = filter.estimate(0), b = shadow->estimate(0);
+        std::fprintf(stderr, "step %d place %d: indexed %d (p %.2f) exhaustive %d (p %.2f); first seen %d\n", k,
+                     route[static_cast<std::size_t>(k)], a.locations[0].founding_observation, a.locations[0].probability,
+                     b.locations[0].founding_observation, b.locations[0].probability,
+                     static_cast<int>(std::find(route.begin(), route.end(), route[static_cast<std::size_t>(k)]) - route.begin()));
+      }
       ++compared, ++window_compared;
       agreed += same, window_agreed += same;
+      const TopologyEstimate exhaustive_estimate = shadow->estimate(0);
+      if (!exhaustive_estimate.locations.empty() && exhaustive_estimate.locations.front().probability >= 0.5) {
+        ++confident, ++window_confident;
+        confident_agreed += same, window_confident_agreed += same;
+      }
       shadow.reset();
     }
     if ((k + 1) % o.checkpoint == 0 || k + 1 == o.places) {
@@ -178,14 +203,15 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       c.index_mb = static_cast<double>(filter.memoryStats().candidate_index_bytes) / (1024.0 * 1024.0);
       c.compared = window_compared;
       c.agreed = window_agreed;
+      c.confident = window_confident;
+      c.confident_agreed = window_confident_agreed;
       checkpoints.push_back(c);
-      rss_x.push_back(c.steps);
-      rss_mb.push_back(c.rss_mb);
       window_ms.clear();
-      window_compared = window_agreed = 0;
+      window_compared = window_agreed = window_confident = window_confident_agreed = 0;
       if (!o.json) {
-        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %8d of %3d\n", c.steps, c.stored, c.step.median_ms,
-                    c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.agreed, c.compared);
+        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %8d of %3d %8d of %3d\n", c.steps, c.stored,
+                    c.step.median_ms, c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.agreed, c.compared,
+                    c.confident_agreed, c.confident);
         std::fflush(stdout);
       }
     }
@@ -199,6 +225,7 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
     json.field("exhaustive_up_to", o.candidates.exhaustive_up_to).field("candidates", o.candidates.candidates);
     json.field("background_samples", o.candidates.background_samples);
     json.field("decisions_compared", compared).field("decisions_same", agreed).field("same_share", share);
+    json.field("confident_compared", confident).field("confident_same", confident_agreed);
     json.field("peak_rss_mb", peak_mb);
     json.key("checkpoints").beginArray();
     for (const Checkpoint& c : checkpoints) {
@@ -206,23 +233,32 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       json.field("steps", c.steps).field("stored", c.stored).field("median_ms", c.step.median_ms);
       json.field("p99_ms", c.step.p99_ms).field("max_ms", c.step.max_ms).field("rss_mb", c.rss_mb);
       json.field("index_mb", c.index_mb).field("compared", c.compared).field("same", c.agreed);
+      json.field("confident", c.confident).field("confident_same", c.confident_agreed);
       json.endObject();
     }
     json.endArray();
     json.endObject();
     std::cout << "\n";
   } else {
-    std::printf("decisions equal to the exhaustive comparison's: %d of %d (%.1f %%); indexed steps %lld; peak RSS "
-                "%.1f MB\n",
-                agreed, compared, 100.0 * share, static_cast<long long>(filter.indexedSteps()), peak_mb);
+    std::printf("decisions equal to the exhaustive comparison's: %d of %d (%.1f %%); where the exhaustive decision "
+                "has p >= 0.5: %d of %d (%.1f %%); indexed steps %lld; peak RSS %.1f MB\n",
+                agreed, compared, 100.0 * share, confident_agreed, confident,
+                confident > 0 ? 100.0 * confident_agreed / confident : 100.0, static_cast<long long>(filter.indexedSteps()),
+                peak_mb);
   }
   if (!o.svg.empty()) {
     SvgPlot time;
     time.title = "ms per new place (" + std::to_string(o.particles) + " particles) and resident MB against map size";
     time.x_label = "places in the map (steps)";
     time.y_label = "ms per step / MB resident";
-    time.series.push_back(SvgSeries{"ms per step", step_x, step_ms, "#1f77b4", 1.0});
-    time.series.push_back(SvgSeries{"resident MB (VmRSS)", rss_x, rss_mb, "#d62728", 2.0});
+    time.series.push_back(SvgSeries{"ms per step, median per 1 % of the run", plot_x, plot_median, "#1f77b4", 1.5});
+    time.series.push_back(SvgSeries{"ms per step, p99 per 1 % of the run", plot_x, plot_p99, "#9ecae1", 1.0});
+    time.series.push_back(SvgSeries{"resident MB (VmRSS)", plot_x, plot_rss, "#d62728", 2.0});
+    time.horizontal_lines.push_back(SvgLine{200.0, "#d62728", true, "200 MB"});
+    time.y_min = 0.0;
+    time.y_max = 250.0;  // a step stalled by the machine (p99 of a window) is drawn at the top edge
+    for (SvgSeries& s : time.series)
+      for (double& y : s.y) y = std::min(y, *time.y_max);
     time.horizontal_lines.push_back(SvgLine{20.0, "#1f77b4", true, "20 ms"});
     if (o.candidates.exhaustive_up_to < o.places)
       time.vertical_lines.push_back(SvgLine{static_cast<double>(o.candidates.exhaustive_up_to), "#555555", true,
