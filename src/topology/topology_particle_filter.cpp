@@ -460,9 +460,9 @@ void TopologyParticleFilter::fillBackground() {
   background_extra_sq_ = static_cast<double>(filled) * variance;
 }
 
-std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::fork() const {
+std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::fork(const SimilarityMeasure& similarity) const {
   if (phase_ != Phase::Idle) throw std::logic_error("TopologyParticleFilter::fork: a step is in progress");
-  auto copy = std::make_unique<TopologyParticleFilter>(config_, similarity_);
+  auto copy = std::make_unique<TopologyParticleFilter>(config_, similarity);
   copy->rng_ = rng_;
   copy->observation_count_ = observation_count_;
   // Memo stamps the original will never reach: the copy's steps cannot pass for the original's.

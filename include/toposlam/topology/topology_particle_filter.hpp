@@ -226,7 +226,9 @@ class TopologyParticleFilter {
   /// observations) pointer copies. For benchmarks and tests that try a step two ways from one state.
   /// Neither copy may step while the other does (they share memo fields). Throws std::logic_error during
   /// a step.
-  std::unique_ptr<TopologyParticleFilter> fork() const;
+  std::unique_ptr<TopologyParticleFilter> fork() const { return fork(similarity_); }
+  /// The same, comparing through `similarity` from now on (it must outlive the copy).
+  std::unique_ptr<TopologyParticleFilter> fork(const SimilarityMeasure& similarity) const;
   /// Steps that compared through the candidate index instead of exhaustively.
   std::int64_t indexedSteps() const { return indexed_steps_; }
   /// Exact similarity evaluations of the last step.

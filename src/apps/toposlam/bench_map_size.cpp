@@ -52,7 +52,23 @@ struct MapSizeBenchOptions {
   std::string samples;
   std::string svg;
   bool json = false;
+  bool control = false;  ///< also a second exhaustive fork whose similarities differ by 1e-6
   CandidateSelectionConfig candidates;
+};
+
+/// The control's similarity: the same up to a relative 1e-6 that depends on the pair (deterministic).
+class NudgedSimilarity final : public SimilarityMeasure {
+ public:
+  explicit NudgedSimilarity(const SimilarityMeasure& inner) : inner_(inner) {}
+  double similarity(const Fingerprint& reference, const Fingerprint& query) const override {
+    const double s = inner_.similarity(reference, query);
+    const auto a = reference.descriptors.empty() ? 0u : reference.descriptors.data[0];
+    const auto b = query.descriptors.empty() ? 0u : query.descriptors.data[1];
+    return s * (1.0 + 1e-6 * (static_cast<double>((a * 31u + b) % 17u) / 16.0 - 0.5));
+  }
+
+ private:
+  const SimilarityMeasure& inner_;
 };
 
 double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
@@ -148,6 +164,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   std::vector<double> window_ms, plot_window_ms, plot_x, plot_median, plot_p99, plot_rss;
   int compared = 0, agreed = 0, window_compared = 0, window_agreed = 0;
   int confident = 0, confident_agreed = 0, window_confident = 0, window_confident_agreed = 0;
+  int control_same = 0, control_confident = 0, control_confident_same = 0;
+  const NudgedSimilarity nudged(similarity);
   if (!o.json)
     std::printf("map-size: %d steps, %d particles, %zu donor frames of %s; exhaustive up to %d stored, then %d "
                 "candidates + %d background samples; decisions compared every %d steps\n%8s %8s %10s %10s %10s "
@@ -176,8 +194,22 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       plot_window_ms.clear();
     }
     if (shadow) {
+      std::unique_ptr<TopologyParticleFilter> control;
+      if (o.control) {
+        control = shadow->fork(nudged);  // before the shadow's step: the same state
+      }
       shadow->step(observation);
       const bool same = decisionOf(*shadow) == decisionOf(filter);
+      if (control) {
+        control->step(observation);
+        const bool control_agrees = decisionOf(*control) == decisionOf(*shadow);
+        control_same += control_agrees;
+        const TopologyEstimate e = shadow->estimate(0);
+        if (!e.locations.empty() && e.locations.front().probability >= 0.5) {
+          ++control_confident;
+          control_confident_same += control_agrees;
+        }
+      }
       if (!same && std::getenv("TOPOSLAM_DEBUG_MAPSIZE")) {
         const TopologyEstimate a = filter.estimate(0), b = shadow->estimate(0);
         std::fprintf(stderr, "step %d place %d: indexed %d (p %.2f) exhaustive %d (p %.2f); first seen %d\n", k,
@@ -226,6 +258,7 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
     json.field("background_samples", o.candidates.background_samples);
     json.field("decisions_compared", compared).field("decisions_same", agreed).field("same_share", share);
     json.field("confident_compared", confident).field("confident_same", confident_agreed);
+    if (o.control) json.field("control_same", control_same).field("control_confident_same", control_confident_same);
     json.field("peak_rss_mb", peak_mb);
     json.key("checkpoints").beginArray();
     for (const Checkpoint& c : checkpoints) {
@@ -245,6 +278,11 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
                 agreed, compared, 100.0 * share, confident_agreed, confident,
                 confident > 0 ? 100.0 * confident_agreed / confident : 100.0, static_cast<long long>(filter.indexedSteps()),
                 peak_mb);
+    if (o.control)
+      std::printf("control, exhaustive with similarities nudged by 1e-6 against exhaustive: %d of %d the same (%.1f "
+                  "%%); where decided: %d of %d\n",
+                  control_same, compared, compared > 0 ? 100.0 * control_same / compared : 100.0,
+                  control_confident_same, control_confident);
   }
   if (!o.svg.empty()) {
     SvgPlot time;
@@ -298,6 +336,9 @@ void addBenchMapSize(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--svg", o->svg, "Write the plot of ms and MB per step against map size here");
   cmd->add_flag("--json", o->json, "JSON instead of the table");
+  cmd->add_flag("--control", o->control,
+                "Also step a second exhaustive fork whose similarities differ by a relative 1e-6: how often the "
+                "filter's own decision survives a change that small");
   cmd->callback([o] { runMapSizeBench(*o); });
 }
 
