@@ -51,12 +51,14 @@ def check_pipeline(toposlam):
 def check_map_size(toposlam):
     out = run([toposlam, "bench", "map-size", "--json", "--places", "120", "--particles", "50", "--checkpoint",
                "60", "--exhaustive-up-to", "40", "--candidates", "20", "--background-samples", "20",
-               "--compare-every", "10"])
+               "--compare-every", "10", "--control"])
     assert out["steps"] == 120
     assert out["indexed_steps"] > 0, out["indexed_steps"]
     assert out["decisions_compared"] == 11, out["decisions_compared"]
     assert 0 <= out["decisions_same"] <= out["decisions_compared"]
     assert 0.0 <= out["same_share"] <= 1.0
+    assert 0 <= out["confident_same"] <= out["confident_compared"] <= out["decisions_compared"]
+    assert 0 <= out["control_same"] <= out["decisions_compared"]
     assert out["peak_rss_mb"] > 0
     steps = [c["steps"] for c in out["checkpoints"]]
     assert steps == [60, 120], steps
