@@ -249,6 +249,9 @@ std::vector<ConfigKey> makeKeys() {
                    "status message period"));
   k.push_back(integer("pipeline.thumbnail_width", AT(pipeline.thumbnail_width), 160, 16, 1280, "pixels",
                       "place-event thumbnail width (the height keeps the aspect)"));
+  k.push_back(integer("pipeline.opencv_threads", AT(pipeline.opencv_threads), 1, 0, 64, "threads",
+                      "OpenCV's own pool, set at start (1: each OpenCV call runs on its stage thread; the thread "
+                      "table gives out the parallelism, docs/performance.md)"));
   // Fingerprint (VpackConfig, its pool size beside it).
   k.push_back(integer("fingerprint.workers", AT(fingerprint_workers), 2, 1, 64, "threads",
                       "WorkerPool threads for the per-subregion work, incl. the fingerprint thread"));
@@ -444,6 +447,16 @@ std::vector<ConfigKey> makeKeys() {
                   .exclusive(false, true));
   k.push_back(integer("topology.sequence_evidence.min_gap_keyframes", AT(sequence_evidence.loop.min_gap_keyframes), 20,
                       1, 1000000, "keyframes", "detections at least this many keyframes back"));
+  // Large maps (CandidateSelectionConfig; docs/topology.md): exhaustive up to a size, then an index.
+  k.push_back(integer("topology.candidates.exhaustive_up_to", AT(topology.candidates.exhaustive_up_to), 1000, 0,
+                      1000000000, "representatives",
+                      "compare a new place with every stored representative up to this many; above, through the "
+                      "candidate index"));
+  k.push_back(integer("topology.candidates.candidates", AT(topology.candidates.candidates), 200, 1, 100000,
+                      "representatives", "compared exactly from the index's top"));
+  k.push_back(integer("topology.candidates.background_samples", AT(topology.candidates.background_samples), 300, 0,
+                      100000, "representatives",
+                      "evenly spread stored representatives also compared exactly, for the others' statistics"));
   k.push_back(integer("topology.slice_items", AT(topology_slice_items), 256, 1, 1000000, "work items",
                       "work items per advance() slice (the time budget is checked between slices)"));
   k.push_back(integer("topology.alternatives", AT(topology_alternatives), 3, 0, 16, "nodes",
@@ -581,6 +594,7 @@ const std::vector<ConfigSection>& daemonConfigSections() {
        "segmentation is by time"},
       {"segmentation.valley", "valley detector on lambda2 (Algorithm 4.1)"},
       {"topology", "particle filter over topologies (thesis ch. 5, docs/topology.md)"},
+      {"topology.candidates", "large maps: which stored places a new one is compared with (docs/topology.md)"},
       {"topology.sequence_evidence",
        "runs of frames as the filter's second evidence (docs/topology.md, \"Sequence evidence in the filter\")"},
   };

@@ -129,6 +129,7 @@ ParticleFilterTopologyStage::ParticleFilterTopologyStage(const TopologyFilterCon
       clock_(clock),
       slice_items_(static_cast<std::size_t>(std::max(1, slice_items))),
       alternatives_(std::max(0, alternatives)),
+      candidates_(config.candidates),
       filter_(std::make_unique<TopologyParticleFilter>(config, similarity)) {
   topology_.particles = config.particles;
 }
@@ -139,6 +140,7 @@ void ParticleFilterTopologyStage::loadMap(const std::string& path) { adoptMap(Ma
 
 void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   filter_ = std::move(loaded.filter);
+  filter_->setCandidateSelection(candidates_);  // how this process compares, not saved with the map
   // The application data lists the representative frames of the run that saved the map; frame numbers of
   // an older run mean nothing in this one, so resumed observations show -1.
   representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);

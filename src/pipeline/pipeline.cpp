@@ -9,6 +9,7 @@
 #include <deque>
 #include <stdexcept>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
@@ -56,6 +57,7 @@ std::string PipelineConfig::validate() const {
     if (std::string problem = settings->validate(); !problem.empty()) return std::string(key) + "." + problem;
   if (!(filter_budget_ms >= 0.1 && filter_budget_ms <= 1000.0))
     return rangeError("filter_budget_ms", filter_budget_ms, "0.1 .. 1000 (milliseconds)");
+  if (opencv_threads < 0 || opencv_threads > 64) return rangeError("opencv_threads", opencv_threads, "0 .. 64 (threads)");
   if (!(status_period_s >= 0.1 && status_period_s <= 60.0))
     return rangeError("status_period_s", status_period_s, "0.1 .. 60 (seconds)");
   if (thumbnail_width < 16 || thumbnail_width > 1280)
@@ -163,6 +165,8 @@ void Pipeline::start() {
   last_frame_fingerprinted_s_.store(start_time_s_);
   last_frame_failed_s_.store(start_time_s_);
   if (config_.record_latencies) latencies_ms_.reserve(1 << 16);
+  // Before any stage thread exists: OpenCV's pool must not compete with the table's threads.
+  cv::setNumThreads(config_.opencv_threads);
   {
     std::lock_guard lock(status_mutex_);
     status_.state = "running";

@@ -124,6 +124,15 @@ std::string TopologyFilterConfig::validate() const {
   if (!(relative_offset >= -10.0 && relative_offset <= 10.0)) return "relative_offset: must be in [-10, 10]";
   if (!(relative_sigma_floor > 0.0 && relative_sigma_floor <= 1.0))
     return "relative_sigma_floor: must be in (0, 1]";
+  if (const std::string problem = candidates.validate(); !problem.empty()) return "candidates." + problem;
+  return "";
+}
+
+std::string CandidateSelectionConfig::validate() const {
+  if (exhaustive_up_to < 0 || exhaustive_up_to > 1000000000) return "exhaustive_up_to: must be in [0, 1000000000]";
+  if (candidates < 1 || candidates > 100000) return "candidates: must be in [1, 100000]";
+  if (background_samples < 0 || background_samples > 100000) return "background_samples: must be in [0, 100000]";
+  if (const std::string problem = index.validate(); !problem.empty()) return "index." + problem;
   return "";
 }
 
@@ -209,6 +218,7 @@ void TopologyParticleFilter::relativeLikelihoods() {
     sum += s;
     sum_sq += s * s;
   }
+  sum_sq += background_extra_sq_;  // 0 unless indexed: the spread the background values stand for
   const int others = static_cast<int>(needed_list_.size()) - 1;
   for (const std::int32_t o : needed_list_) {
     double& s = similarity_of_[idx(o)];
@@ -267,20 +277,23 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
         for (std::size_t o = 0; o < needed_.size(); ++o) {
           if (needed_[o]) {
             needed_list_.push_back(static_cast<std::int32_t>(o));
-          } else {
+          } else if (fingerprints_[o]) {
+            if (index_) index_->remove(static_cast<int>(o), *fingerprints_[o]);
             fingerprints_[o].reset();  // no particle refers to it any more: forget it
           }
         }
+        selectComparisons();
         phase_ = Phase::Similarity;
         cursor_ = 0;
         break;
       case Phase::Similarity:
-        for (; cursor_ < needed_list_.size(); ++cursor_) {
+        for (; cursor_ < compared_list_.size(); ++cursor_) {
           if (used++ >= budget) return false;
-          const auto o = idx(needed_list_[cursor_]);
+          const auto o = idx(compared_list_[cursor_]);
           const double s = similarity_.similarity(*fingerprints_[o], *pending_);
           similarity_of_[o] = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
         }
+        if (indexed_step_) fillBackground();
         if (config_.likelihood == LikelihoodModel::Relative) relativeLikelihoods();
         for (const std::int32_t o : needed_list_)
           if (idx(o) < evidence_.size()) similarity_of_[idx(o)] = std::max(similarity_of_[idx(o)], evidence_[idx(o)]);
@@ -394,7 +407,91 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
   return true;
 }
 
+void TopologyParticleFilter::selectComparisons() {
+  // needed_ marks: 1 = stored, 2 = compared (candidate or not indexable), 3 = compared (background sample).
+  compared_list_ = needed_list_;
+  indexed_step_ = false;
+  background_extra_sq_ = 0.0;
+  const CandidateSelectionConfig& c = config_.candidates;
+  if (needed_list_.size() <= idx(c.exhaustive_up_to) || !PlaceCandidateIndex::supports(*pending_)) return;
+  if (!index_) {
+    index_ = std::make_unique<PlaceCandidateIndex>(c.index);
+    for (std::size_t o = 0; o < fingerprints_.size(); ++o)
+      if (fingerprints_[o]) index_->add(static_cast<int>(o), *fingerprints_[o]);
+  }
+  indexed_step_ = true;
+  ++indexed_steps_;
+  for (const int o : index_->candidates(*pending_, c.candidates)) needed_[idx(o)] = 2;
+  std::size_t rest = 0;
+  for (const std::int32_t o : needed_list_) {
+    if (needed_[idx(o)] != 1) continue;
+    if (PlaceCandidateIndex::supports(*fingerprints_[idx(o)])) {
+      ++rest;
+    } else {
+      needed_[idx(o)] = 2;  // the index cannot hold it: always compared
+    }
+  }
+  const std::size_t samples = std::min(rest, idx(c.background_samples));
+  std::size_t seen = 0, next_sample = 0, taken = 0;
+  for (const std::int32_t o : needed_list_) {
+    if (needed_[idx(o)] != 1) continue;
+    // Evenly spread: the i-th sample is the (i * rest / samples)-th of the rest, in observation order.
+    if (taken < samples && seen == next_sample) {
+      needed_[idx(o)] = 3;
+      ++taken;
+      next_sample = taken * rest / samples;
+    }
+    ++seen;
+  }
+  compared_list_.clear();
+  for (const std::int32_t o : needed_list_)
+    if (needed_[idx(o)] >= 2) compared_list_.push_back(o);
+}
+
+void TopologyParticleFilter::fillBackground() {
+  double sum = 0.0, sum_sq = 0.0;
+  std::size_t samples = 0, filled = 0;
+  for (const std::int32_t o : compared_list_) {
+    if (needed_[idx(o)] != 3) continue;
+    const double s = similarity_of_[idx(o)];
+    sum += s;
+    sum_sq += s * s;
+    ++samples;
+  }
+  const double mean = samples > 0 ? sum / static_cast<double>(samples) : 0.0;
+  const double variance = samples > 0 ? std::max(0.0, sum_sq / static_cast<double>(samples) - mean * mean) : 0.0;
+  for (const std::int32_t o : needed_list_) {
+    if (needed_[idx(o)] != 1) continue;
+    similarity_of_[idx(o)] = mean;
+    ++filled;
+  }
+  background_extra_sq_ = static_cast<double>(filled) * variance;
+}
+
+std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::fork(const SimilarityMeasure& similarity) const {
+  if (phase_ != Phase::Idle) throw std::logic_error("TopologyParticleFilter::fork: a step is in progress");
+  auto copy = std::make_unique<TopologyParticleFilter>(config_, similarity);
+  copy->rng_ = rng_;
+  copy->observation_count_ = observation_count_;
+  // Memo stamps the original will never reach: the copy's steps cannot pass for the original's.
+  copy->stamp_ = stamp_ + (std::uint64_t{1} << 62);
+  copy->fingerprints_ = fingerprints_;
+  copy->particles_ = particles_;
+  copy->last_ess_ = last_ess_;
+  copy->degenerate_steps_ = degenerate_steps_;
+  return copy;
+}
+
+void TopologyParticleFilter::setCandidateSelection(const CandidateSelectionConfig& candidates) {
+  if (phase_ != Phase::Idle) throw std::logic_error("TopologyParticleFilter::setCandidateSelection: a step is in progress");
+  if (const std::string problem = candidates.validate(); !problem.empty())
+    throw std::invalid_argument("candidates." + problem);
+  config_.candidates = candidates;
+  index_.reset();
+}
+
 void TopologyParticleFilter::finishStep() {
+  if (index_) index_->add(observation_count_, *pending_);
   particles_.swap(next_particles_);
   next_particles_.clear();
   children_.clear();
@@ -513,6 +610,7 @@ TopologyMemoryStats TopologyParticleFilter::memoryStats() const {
   stats.history_records = records.size();
   stats.trie_nodes = trie.size();
   for (const auto& f : fingerprints_) stats.stored_fingerprints += f ? 1 : 0;
+  stats.candidate_index_bytes = index_ ? index_->bytes() : 0;
   return stats;
 }
 

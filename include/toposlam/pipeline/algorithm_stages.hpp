@@ -143,6 +143,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   const Clock& clock_;
   std::size_t slice_items_;
   int alternatives_;
+  CandidateSelectionConfig candidates_;  ///< re-applied to a loaded map
   std::unique_ptr<TopologyParticleFilter> filter_;
   std::deque<std::shared_ptr<const Fingerprint>> queue_;  ///< representatives waiting for their step
   std::vector<std::int64_t> representative_frames_;        ///< per observation (-1: from an older run)

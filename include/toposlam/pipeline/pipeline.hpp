@@ -72,6 +72,10 @@ struct PipelineConfig {
   double map_save_period_s = 60.0;   ///< periodic save, seconds (0 = only at stop; else 1 .. 86400)
   double heartbeat_timeout_s = 5.0;  ///< a thread silent this long makes healthy() false (0.5 .. 600)
   bool record_latencies = false;     ///< keep every frame's capture-to-publish latency (benchmark)
+  /// OpenCV's own thread pool, set at start (cv::setNumThreads, process-wide). 1: OpenCV runs each call
+  /// on the calling stage thread, so the only threads are the table's and the fingerprint workers
+  /// (docs/performance.md, "OpenCV's threads"). 0 .. 64; 0 is OpenCV's "sequential" too.
+  int opencv_threads = 1;
   /// "" or "<key>: <problem, allowed range>" with keys relative to the pipeline section.
   std::string validate() const;
 };

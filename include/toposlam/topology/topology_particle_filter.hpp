@@ -42,6 +42,7 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/topology/place_candidate_index.hpp"
 
 namespace toposlam {
 
@@ -72,6 +73,21 @@ LikelihoodModel parseLikelihoodModel(const std::string& name);
 double relativeLikelihood(double similarity, double others_sum, double others_sum_sq, int others_count,
                           double slope, double offset, double sigma_floor);
 
+/// How step 1 compares the new representative once many are stored (issue 18, docs/topology.md "Large
+/// maps"). Up to `exhaustive_up_to` stored representatives it is compared with every one (the thesis).
+/// Above, a PlaceCandidateIndex over the stored descriptors picks the `candidates` most likely ones; those,
+/// every stored representative the index cannot hold (no binary descriptors), and `background_samples`
+/// others spread evenly over the rest are compared exactly; every other stored representative is given
+/// the mean similarity of those samples (the background), and the relative likelihood's spread includes
+/// the samples' variance for them. Not saved with the map: it is how this process runs, not what the map is.
+struct CandidateSelectionConfig {
+  int exhaustive_up_to = 1000;  ///< stored representatives compared exhaustively; allowed [0, 1e9]
+  int candidates = 200;         ///< compared exactly from the index's top; allowed [1, 100000]
+  int background_samples = 300; ///< others compared exactly for the background; allowed [0, 100000]
+  PlaceCandidateIndexConfig index;
+  std::string validate() const;
+};
+
 struct TopologyFilterConfig {
   int particles = 500;                   ///< M (thesis: 500); allowed [1, 1000000]
   double alpha = 15.0;                   ///< prior map size of eq. 5.8 (thesis: 15); allowed (0, 1e6]
@@ -89,6 +105,8 @@ struct TopologyFilterConfig {
   double relative_slope = 3.0;         ///< logistic slope per z unit; allowed (0, 100]
   double relative_offset = 2.5;        ///< z at which the likelihood is 1/2; allowed [-10, 10]
   double relative_sigma_floor = 0.02;  ///< smallest spread of the others' similarities; allowed (0, 1]
+  /// Not part of the saved state (a loaded map has the defaults until setCandidateSelection()).
+  CandidateSelectionConfig candidates;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
   std::string validate() const;
 };
@@ -145,6 +163,7 @@ struct TopologyMemoryStats {
   std::size_t history_records = 0;  ///< live assignment records (shared by all particles)
   std::size_t trie_nodes = 0;       ///< live node-table trie nodes (shared)
   std::size_t stored_fingerprints = 0;
+  std::size_t candidate_index_bytes = 0;  ///< heap held by the candidate index (0 until it is built)
 };
 
 /// The filter's state between two steps, frozen (TopologyParticleFilter::freeze()). The particles and
@@ -202,6 +221,21 @@ class TopologyParticleFilter {
   /// Steps whose weights were all zero (resampled uniformly).
   std::int64_t degenerateSteps() const { return degenerate_steps_; }
   TopologyMemoryStats memoryStats() const;
+  /// Replaces config().candidates (between steps; throws std::logic_error during a step and
+  /// std::invalid_argument when invalid). The index is rebuilt from the stored representatives when
+  /// next needed.
+  void setCandidateSelection(const CandidateSelectionConfig& candidates);
+  /// A copy that shares this filter's immutable state (particles, stored representatives): O(particles +
+  /// observations) pointer copies. For benchmarks and tests that try a step two ways from one state.
+  /// Neither copy may step while the other does (they share memo fields). Throws std::logic_error during
+  /// a step.
+  std::unique_ptr<TopologyParticleFilter> fork() const { return fork(similarity_); }
+  /// The same, comparing through `similarity` from now on (it must outlive the copy).
+  std::unique_ptr<TopologyParticleFilter> fork(const SimilarityMeasure& similarity) const;
+  /// Steps that compared through the candidate index instead of exhaustively.
+  std::int64_t indexedSteps() const { return indexed_steps_; }
+  /// Exact similarity evaluations of the last step.
+  std::size_t lastStepComparisons() const { return compared_list_.size(); }
   /// Representatives still referenced by some particle (the ones step 1 compares against).
   std::shared_ptr<const Fingerprint> storedRepresentative(int observation) const;
 
@@ -223,6 +257,10 @@ class TopologyParticleFilter {
   void finishStep();
   /// LikelihoodModel::Relative: turns this step's similarities into relative likelihoods, in place.
   void relativeLikelihoods();
+  /// After Collect: which stored representatives step 1 compares exactly (compared_list_).
+  void selectComparisons();
+  /// After the exact comparisons of an indexed step: the background for the others.
+  void fillBackground();
 
   TopologyFilterConfig config_;
   const SimilarityMeasure& similarity_;
@@ -246,6 +284,11 @@ class TopologyParticleFilter {
   std::vector<std::int32_t> needed_list_;
   std::vector<double> similarity_of_;  ///< per observation, this step
   std::vector<double> evidence_;       ///< per observation, this step (beginStep's; may be shorter)
+  std::vector<std::int32_t> compared_list_;  ///< compared exactly this step (all of needed_list_ unless indexed)
+  bool indexed_step_ = false;
+  double background_extra_sq_ = 0.0;  ///< sum of squared deviations the background values stand for
+  std::int64_t indexed_steps_ = 0;
+  std::unique_ptr<PlaceCandidateIndex> index_;  ///< holds the stored representatives once built
   struct GroupStats {
     double max = 0.0;
     double new_likelihood = 1.0;

@@ -139,6 +139,8 @@ void addBenchCommand(CLI::App& app) {
   addBenchSegmentation(*bench);
   addBenchSim(*bench);
   addBenchMatching(*bench);
+  addBenchPipeline(*bench);
+  addBenchMapSize(*bench);
 }
 
 }  // namespace toposlam::cli

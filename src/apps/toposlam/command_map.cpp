@@ -72,6 +72,7 @@ struct MapOptions {
   double sequence_evidence_min_share = SequenceEvidenceConfig{}.min_share;
   double loop_min_gap_s = 20.0;       ///< sequence: detections at least this long back
   int max_keypoints = -1;             ///< -1: the preset's
+  CandidateSelectionConfig candidates;  ///< large maps: --exhaustive-up-to, --candidates
   std::string likelihood = toString(methodPreset("default").topology.likelihood);
   double relative_slope = methodPreset("default").topology.relative_slope;
   double relative_offset = methodPreset("default").topology.relative_offset;
@@ -186,6 +187,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
         throw ConfigError("map: " + refusal + " (" + hint + ")");
     }
     filter = std::move(loaded.filter);
+    filter->setCandidateSelection(o.candidates);  // how this run compares, not saved with the map
     origins = decodeOrigins(loaded.application_data, filter->observationCount());
     for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
     std::cerr << "map: resumed " << o.resume << " (" << filter->observationCount() << " places)\n";
@@ -199,6 +201,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (o.slope_given->count() > 0) config.relative_slope = o.relative_slope;
     if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
     if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
+    config.candidates = o.candidates;
     if (const std::string problem = config.validate(); !problem.empty())
       throw std::invalid_argument("map: " + problem);
     filter = std::make_unique<TopologyParticleFilter>(config, similarity);
@@ -556,6 +559,15 @@ void addMapCommand(CLI::App& app) {
   options->floor_given = cmd->add_option("--relative-sigma-floor", options->relative_sigma_floor,
                                          "Relative likelihood: smallest spread of the other similarities")
                              ->capture_default_str();
+  cmd->add_option("--exhaustive-up-to", options->candidates.exhaustive_up_to,
+                  "A new place is compared with every stored representative up to this many; above, with the "
+                  "candidate index's top only (docs/topology.md, \"Large maps\")")
+      ->check(CLI::Range(0, 1000000000))
+      ->capture_default_str();
+  cmd->add_option("--candidates", options->candidates.candidates,
+                  "Above --exhaustive-up-to: stored representatives compared exactly from the index's top")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   auto* reps = cmd->add_option("--max-representatives", options->max_representatives,
                                "Representatives kept per node (oldest dropped)")
                    ->check(keyRange("topology.max_representatives_per_node"))

@@ -26,5 +26,7 @@ void addBenchTopology(CLI::App& bench);
 void addBenchSegmentation(CLI::App& bench);
 void addBenchSim(CLI::App& bench);
 void addBenchMatching(CLI::App& bench);
+void addBenchPipeline(CLI::App& bench);
+void addBenchMapSize(CLI::App& bench);
 
 }  // namespace toposlam::cli

@@ -42,8 +42,7 @@ int main(int argc, char** argv) {
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
-  bool check_only = false, print_config = false, bench = false;
-  toposlam::daemon::BenchOptions bench_options;
+  bool check_only = false, print_config = false;
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml and docs/config.md). Default: " +
                                                  toposlam::defaultDaemonConfigPath() + " if it exists, else built-in defaults");
   // The override options come from the key table (config_keys.cpp): one per key that names one. A flag
@@ -78,8 +77,6 @@ int main(int argc, char** argv) {
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
   app.add_flag("--print-config", print_config,
                "print the effective config (file, defaults and options) as YAML with every key, and exit");
-  app.add_flag("--bench", bench, "benchmark: fps and capture-to-publish latency at 320x240 and 640x480, then exit");
-  app.add_option("--bench-frames", bench_options.frames, "frames per benchmark run")->check(CLI::Range(10, 100000));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -127,10 +124,6 @@ int main(int argc, char** argv) {
     }
     spdlog::info("toposlamd: config {}; logging at {} to {}", config_path, config.log_level,
                  journal ? "the journal (priorities, no timestamps)" : "stderr");
-    if (bench) {
-      bench_options.source = config.source;
-      return toposlam::daemon::runBench(config, bench_options);
-    }
     return toposlam::daemon::runDaemon(config);
   } catch (const toposlam::ConfigError& e) {
     return startError(e, 2);
