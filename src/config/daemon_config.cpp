@@ -210,6 +210,15 @@ void readConfig(const YAML::Node& root, DaemonConfig& c) {
     map.finish();
   }
   {
+    Section record = top.child("record");
+    record.text("dir", c.record.dir, 4096, true);
+    record.real("max_mb", c.record.max_mb, 1, 1e7, " MB");
+    c.record.format = record.choice("format", c.record.format, {"jpg", "png"});
+    record.integer("jpeg_quality", c.record.jpeg_quality, 1, 100);
+    record.integer("queue_frames", c.record.queue_frames, 1, 1024, " frames");
+    record.finish();
+  }
+  {
     Section watchdog = top.child("watchdog");
     watchdog.flag("enabled", c.watchdog);
     watchdog.real("heartbeat_timeout_s", c.pipeline.heartbeat_timeout_s, 0.5, 600, " seconds");
@@ -425,6 +434,14 @@ std::string DaemonConfig::validate() const {
   }
   if (lcm.jpeg_quality < 1 || lcm.jpeg_quality > 100)
     return "lcm.jpeg_quality: " + std::to_string(lcm.jpeg_quality) + " is out of range, allowed 1 .. 100";
+  if (!(record.max_mb >= 1 && record.max_mb <= 1e7))
+    return "record.max_mb: " + formatNumber(record.max_mb) + " is out of range, allowed [1, 1e+07] MB";
+  if (record.format != "jpg" && record.format != "png")
+    return "record.format: '" + record.format + "' is not allowed, expected one of: jpg, png";
+  if (record.jpeg_quality < 1 || record.jpeg_quality > 100)
+    return "record.jpeg_quality: " + std::to_string(record.jpeg_quality) + " is out of range, allowed 1 .. 100";
+  if (record.queue_frames < 1 || record.queue_frames > 1024)
+    return "record.queue_frames: " + std::to_string(record.queue_frames) + " is out of range, allowed 1 .. 1024 frames";
   if (fingerprint_workers < 1 || fingerprint_workers > 64)
     return "fingerprint.workers: " + std::to_string(fingerprint_workers) + " is out of range, allowed 1 .. 64";
   if (topology_slice_items < 1 || topology_slice_items > 1000000)

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;
-  std::string source, map_path, lcm_url, overflow;
+  std::string source, map_path, lcm_url, overflow, record_dir;
   bool check_only = false, no_load = false, bench = false, resume_other_source = false;
   std::string log_level;
   double save_period = -1.0;
@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
   auto* map_option = app.add_option("--map", map_path,
                                     "override `map.path` (relative paths resolve against $STATE_DIRECTORY; \"\" = never saved)");
   app.add_option("--lcm-url", lcm_url, "override `lcm.url`");
+  app.add_option("--record", record_dir,
+                 "override `record.dir`: record the frames processed into a new subfolder of DIR (replay: "
+                 "images:DIR/<subfolder>?rate=recorded)");
   app.add_option("--overflow", overflow, "override `pipeline.queues.overflow`")->check(CLI::IsMember({"drop_oldest", "block"}));
   app.add_option("--save-period", save_period, "override `map.save_period_s` (seconds, 0 = only at stop)");
   app.add_flag("--no-map-load", no_load, "start a new map even if the map file exists");
@@ -81,6 +84,7 @@ int main(int argc, char** argv) {
     if (!source.empty()) config.source = source;
     if (map_option->count() > 0) config.pipeline.map_path = map_path;  // --map "" means no map file
     if (!lcm_url.empty()) config.lcm.url = lcm_url;
+    if (!record_dir.empty()) config.record.dir = record_dir;
     if (overflow == "block") config.pipeline.queues.overflow = toposlam::QueueOverflow::Block;
     if (overflow == "drop_oldest") config.pipeline.queues.overflow = toposlam::QueueOverflow::DropOldest;
     if (save_period >= 0.0) config.pipeline.map_save_period_s = save_period;
