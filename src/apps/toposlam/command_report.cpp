@@ -27,6 +27,7 @@
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"
 #include "lcmlog_run_folder.hpp"
+#include "toposlam/core/json_writer.hpp"
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/config/daemon_config.hpp"
 
@@ -45,6 +46,7 @@ struct ReportCommandOptions {
   std::string title;
   eval::EvalOptions eval;
   int thumbnails = 96;
+  bool json = false;
 };
 
 std::vector<fs::path> frameFolders(const ReportCommandOptions& o, std::vector<std::string>& warnings) {
@@ -177,7 +179,7 @@ std::string runFolderOf(const std::string& run_dir) {
   const LoggedRun run = readLoggedRun(log, channels);
   const std::string folder = log + ".run";
   writeRunFolderFromLog(run, log, folder);
-  std::cout << "converted " << log << " (" << run.events << " events: " << run.frames.size() << " place estimates, "
+  std::cerr << "converted " << log << " (" << run.events << " events: " << run.frames.size() << " place estimates, "
             << run.places.size() << " places) into the run folder " << folder << "\n";
   return folder;
 }
@@ -239,6 +241,23 @@ void runReport(ReportCommandOptions o) {
     std::cout << "wrote the figures as SVG files into " << o.figures << "\n";
   }
   for (const auto& w : in.warnings) std::cerr << "report: warning: " << w << "\n";
+  if (o.json) {
+    int thumbnails = 0;
+    for (const std::string& t : in.thumbnails) thumbnails += t.empty() ? 0 : 1;
+    JsonWriter json(std::cout);
+    json.beginObject()
+        .field("report", out.string())
+        .field("bytes", static_cast<std::int64_t>(fs::file_size(out)))
+        .field("run", o.run_dir)
+        .field("frames", in.run.frames.size())
+        .field("places", in.run.places.size())
+        .field("thumbnails", thumbnails)
+        .field("evaluated", in.eval.has_value())
+        .field("warnings", in.warnings.size())
+        .endObject();
+    std::cout << "\n" << std::flush;
+    return;
+  }
   std::cout << "wrote " << out.string() << " (" << fs::file_size(out) / 1024 << " KiB)\n";
 }
 
@@ -263,6 +282,7 @@ void addReportCommand(CLI::App& app) {
   cmd->add_option("--thumbnails", options->thumbnails, "About this many evenly spaced frame thumbnails")
       ->check(CLI::Range(0, 2000))
       ->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print a summary as one JSON object (file, size, frames, places, thumbnails)");
   addEvalMeasureOptions(*cmd, options->eval);
   cmd->callback([options] { runReport(*options); });
 }
