@@ -1,5 +1,5 @@
 #!/bin/sh
-# --json on the commands that print results (issue 16: map, segment, sim, capture, report here; eval,
+# --json on the commands that print results (issue 16: map, segment, sim, capture, report, bench here; eval,
 # fingerprint, similarity, localize, recognition, listen have their own tests) parses as JSON with the run's
 # numbers; the one progress line (count, rate, ETA) shows on a terminal and stays out of pipes.
 # Usage: check_json_and_progress.sh TOPOSLAM SAMPLES DIR
@@ -23,8 +23,14 @@ print(v)" "$1" "$2"; }
 [ "$(field "$dir/capture.json" frames)" = 10 ] && [ "$(field "$dir/capture.json" recorded.frames)" = 10 ] || fail "capture: $(cat "$dir/capture.json")"
 "$toposlam" report "$dir/map" --json >"$dir/report.json" 2>/dev/null || fail "report --json"
 [ "$(field "$dir/report.json" frames)" = 84 ] && [ "$(field "$dir/report.json" thumbnails)" -ge 50 ] || fail "report: $(cat "$dir/report.json")"
-for f in segment map sim capture report; do python3 -m json.tool "$dir/$f.json" >/dev/null || fail "$f.json"; done
-echo "json: segment, map, sim, capture, report parse with their numbers"
+"$toposlam" bench sim --worlds home --widths 64 --route loop --json >"$dir/bench-sim.json" 2>/dev/null || fail "bench sim --json"
+[ "$(field "$dir/bench-sim.json" benchmark)" = sim ] && python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['rows']
+assert len(r) == 1 and r[0]['frames'] > 100 and r[0]['fps'] > 0 and r[0]['width'] == 64, r" "$dir/bench-sim.json" || fail "bench sim: $(cat "$dir/bench-sim.json")"
+"$toposlam" bench topology --places 10 20 --steps 4 --no-real --json >"$dir/bench-topology.json" 2>/dev/null || fail "bench topology --json"
+python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['rows']
+assert [x['places'] for x in r] == [10, 20] and all(x['median_ms'] > 0 for x in r), r" "$dir/bench-topology.json" || fail "bench topology: $(cat "$dir/bench-topology.json")"
+for f in segment map sim capture report bench-sim bench-topology; do python3 -m json.tool "$dir/$f.json" >/dev/null || fail "$f.json"; done
+echo "json: segment, map, sim, capture, report, bench sim, bench topology parse with their numbers"
 
 # Progress: forced on (as on a terminal), one line rewritten in place, then the summary; off in a pipe.
 TOPOSLAM_PROGRESS=1 "$toposlam" map "images:$samples" --out "$dir/map2" 2>"$dir/progress.txt" >/dev/null || fail "map with progress"
