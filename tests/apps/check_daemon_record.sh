@@ -10,6 +10,20 @@ set -u
 toposlam="$1" toposlamd="$2" dir="$3"
 rm -rf "$dir" && mkdir -p "$dir"
 fail() { echo "FAIL: $*"; exit 1; }
+# A notify socket for systemd's STATUS= lines: every datagram one line of FILE (python3, in the background).
+notify_socket() {  # SOCKET FILE
+  /usr/bin/python3 -c '
+import socket, sys
+s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+s.bind(sys.argv[1])
+with open(sys.argv[2], "a") as out:
+    while True:
+        out.write(s.recv(4096).decode().replace("\n", " ") + "\n")
+        out.flush()
+' "$1" "$2" &
+  i=0
+  while [ ! -S "$1" ] && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
+}
 source="sim:office?route=loop&fps=3&size=160x120"  # 481 frames
 daemon() { "$toposlamd" --source "$source" --lcm-url memq:// --map "" --overflow block "$@" 2>&1; }
 
@@ -31,10 +45,19 @@ echo "$out" | grep -q "fps=3.00" || fail "replay: $out"
 seconds="$(echo "$out" | sed -n 's/.* seconds=\([0-9.]*\) .*/\1/p')"
 awk -v s="$seconds" 'BEGIN { exit !(s >= 1.9) }' || fail "7 frames recorded over 2 s replayed in $seconds s"
 
-# 2. The size bound: recording stops, the daemon goes on.
-printf 'record:\n  dir: %s/small\n  format: png\n  max_mb: 1\n  queue_frames: 1024\n' "$dir" >"$dir/small.yaml"
-out="$(daemon -c "$dir/small.yaml")" || fail "size bound: exit $?: $out"
-n="$(ls "$dir"/small/*Z | grep -c '\.png$')"
+# 2. The size bound: recording stops, the daemon goes on; systemd's STATUS= says so (paced at 160 frames/s,
+#    so the daemon runs 3 s and sends a few status lines).
+printf 'record:\n  dir: %s/small\n  max_mb: 1\n  queue_frames: 1024\n' "$dir" >"$dir/small.yaml"  # JPEG: ~4 kB a frame
+notify_socket "$dir/notify.sock" "$dir/notify.log"
+receiver=$!
+out="$(NOTIFY_SOCKET="$dir/notify.sock" "$toposlamd" --source "$source&rate=160" --lcm-url memq:// --map "" --overflow block \
+  -c "$dir/small.yaml" 2>&1)" || fail "size bound: exit $?: $out"
+kill "$receiver"
+grep -q "^STATUS=running: .*; recording [0-9]* frames ([0-9.]* MB, 0 dropped)" "$dir/notify.log" \
+  || fail "no recording in STATUS=: $(cat "$dir/notify.log")"
+grep -q "^STATUS=running: .*; recording stopped at record.max_mb: [0-9]* frames" "$dir/notify.log" \
+  || fail "no 'recording stopped' in STATUS=: $(cat "$dir/notify.log")"
+n="$(ls "$dir"/small/*Z | grep -c '\.jpg$')"
 [ "$n" -ge 10 ] && [ "$n" -lt 481 ] || fail "size bound: $n frames"
 echo "$out" | grep -q "recording stopped: the size bound (record.max_mb) was reached after $n frames" || fail "size bound: $out"
 echo "$out" | grep -q "481 frames published" || fail "size bound: not every frame published: $out"
