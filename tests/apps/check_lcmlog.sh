@@ -2,15 +2,17 @@
 # The lcmlog: replay (issue 16): toposlamd on the simulator publishes into an LCM log (liblcm's file://
 # provider writes lcm-logger's format), `toposlam listen --from lcmlog:FILE` prints every message of it as a
 # live listen would (lines and JSON), `--run-folder` and `toposlam report lcmlog:FILE` make a run folder the
-# report and eval read; a truncated or corrupt log is an error naming the byte offset (exit 1).
+# report and eval read (with the daemon's frame recording as its thumbnails); a truncated or corrupt log is an
+# error naming the byte offset (exit 1).
 # Usage: check_lcmlog.sh TOPOSLAM TOPOSLAMD DIR
 set -u
 toposlam="$1" toposlamd="$2" dir="$3"
 rm -rf "$dir" && mkdir -p "$dir"
 fail() { echo "FAIL: $*"; exit 1; }
 log="$dir/run.lcmlog"
-out="$("$toposlamd" --source "sim:office?route=loop&fps=3&size=160x120" --lcm-url "file://$log?mode=w" --map "" \
-  --overflow block 2>&1)" || fail "toposlamd: $out"
+printf 'record:\n  dir: %s/rec\n  queue_frames: 1024\n' "$dir" >"$dir/record.yaml"  # the frames too, for the report
+out="$("$toposlamd" -c "$dir/record.yaml" --source "sim:office?route=loop&fps=3&size=160x120" --lcm-url "file://$log?mode=w" \
+  --map "" --overflow block 2>&1)" || fail "toposlamd: $out"
 places="$(echo "$out" | sed -n 's/.*toposlamd: 481 frames published, 0 dropped, \([0-9]*\) places.*/\1/p')"
 [ -n "$places" ] && [ "$places" -ge 5 ] || fail "toposlamd: $out"
 
@@ -47,6 +49,10 @@ out="$("$toposlam" report "lcmlog:$log" 2>&1)" || fail "report lcmlog: $out"
 echo "$out" | grep -q "^converted $log ([0-9]* events: 481 place estimates, $places places) into the run folder $log.run$" \
   || fail "report lcmlog: $out"
 grep -q "<svg" "$log.run/report.html" || fail "the report has no figure"
+# With the daemon's own recording as the frames: every thumbnail found (frames.csv names them as recorded).
+"$toposlam" report "lcmlog:$log" --frames "$(ls -d "$dir"/rec/*Z)" --json >"$dir/report.json" 2>/dev/null || fail "report --frames"
+python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['frames'] == 481 and r['thumbnails'] >= 50 and r['warnings'] == 0, r" \
+  "$dir/report.json" || fail "report with the recording: $(cat "$dir/report.json")"
 echo "report: $(echo "$out" | grep '^wrote')"
 
 # Damaged logs: the messages before the damage, then the error with the offset, exit 1.
