@@ -9,6 +9,7 @@
 #include <mutex>
 #include <condition_variable>
 
+#include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "toposlam/io/sim_source.hpp"
@@ -24,7 +25,9 @@ struct SchemeEntry {
 };
 
 // Holds the next frame until it is due; the wait is bounded (nextFor) and ends early on interrupt(). Due:
-// frame k at k / rate_hz after the first, or with rate_hz 0 at its timestamp's offset from the first's.
+// frame k at k / rate_hz after the first, or with rate_hz 0 at its timestamp's offset from the first's on
+// a FrameTimeline: a timestamp that goes back is due one typical interval after the frame before (not all
+// at once until the recording catches up with its own clock); a jump forward is waited for, as recorded.
 class RateLimitedSource : public FrameSource {
  public:
   RateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz) : inner_(std::move(inner)), rate_hz_(rate_hz) {}
@@ -46,12 +49,13 @@ class RateLimitedSource : public FrameSource {
       const SourceWait wait = inner_->nextFor(timeout, frame);
       if (wait != SourceWait::Frame) return wait;
       const auto now = std::chrono::steady_clock::now();
+      const double placed_s = rate_hz_ > 0 ? 0.0 : timeline_.place(frame.timestamp_s);
       if (delivered_ == 0) {
         start_ = now;
-        first_timestamp_s_ = frame.timestamp_s;
+        first_timestamp_s_ = placed_s;
       }
       const double offset_s = rate_hz_ > 0 ? static_cast<double>(delivered_) / rate_hz_
-                                           : std::max(0.0, frame.timestamp_s - first_timestamp_s_);
+                                           : std::max(0.0, placed_s - first_timestamp_s_);
       due_ = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(offset_s));
       pending_ = std::move(frame);
     }
@@ -82,7 +86,8 @@ class RateLimitedSource : public FrameSource {
  private:
   std::unique_ptr<FrameSource> inner_;
   double rate_hz_;  ///< 0: the recorded rate (frame timestamps)
-  double first_timestamp_s_ = 0.0;
+  double first_timestamp_s_ = 0.0;  ///< on timeline_
+  FrameTimeline timeline_;          ///< the recorded timestamps with their steps back cut out
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point due_;
   std::optional<Frame> pending_;  ///< taken from the inner source, not yet due

@@ -176,6 +176,7 @@ void applyPreset(const MethodPreset& preset, DaemonConfig& c) {
   c.similarity = preset.similarity;
   c.segmentation = preset.segmentation;
   c.topology = preset.topology;
+  c.sequence_evidence = preset.sequence_evidence;
 }
 
 void readConfig(const YAML::Node& root, DaemonConfig& c) {

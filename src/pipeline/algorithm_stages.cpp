@@ -15,8 +15,10 @@ namespace toposlam {
 
 FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
                                                    const SimilarityMeasure& similarity,
-                                                   std::size_t max_thumbnails, const MotionGateConfig& motion)
+                                                   std::size_t max_thumbnails, const MotionGateConfig& motion,
+                                                   const SequenceEvidenceConfig& evidence)
     : segmenter_(config, similarity),
+      evidence_(evidence.weight > 0.0 ? std::make_unique<PlaceSequenceEvidence>(evidence, similarity) : nullptr),
       max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)),
       gate_(motion) {
   thumbnails_.reserve(max_thumbnails_ + 1);
@@ -67,12 +69,16 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   }
   // The window's clock is the frame's source time (a window in seconds of the world, also when a file or
   // the simulator plays faster than real time); motion is looked up at the pipeline clock, the clock of
-  // motion_t.utime. A source time that does not increase (a source without timestamps) falls back to
-  // the frame number, so the window still moves.
-  double time_s = source_time_s;
-  if (!(std::isfinite(time_s) && time_s > last_source_time_s_))
-    time_s = std::isfinite(last_source_time_s_) ? last_source_time_s_ + 1.0 : 0.0;
-  last_source_time_s_ = time_s;
+  // motion_t.utime. A source time that goes back is carried on from the previous frame (FrameTimeline),
+  // so the window neither keeps every frame "from the future" nor turns into a window of frames; one that
+  // does not increase (a source without timestamps) advances by a second, as before.
+  const std::int64_t steps_back = timeline_.stepsBack();
+  const double time_s = timeline_.place(source_time_s);
+  if (timeline_.stepsBack() > steps_back && (steps_back < 10 || steps_back % 1000 == 0))
+    spdlog::warn("segmentation: frame {}'s source time went back {:.3f} s (to {:.3f} s); the window's clock carries on "
+                 "from the frame before ({} such steps so far)",
+                 sequence, timeline_.lastStepBackS(), source_time_s, steps_back + 1);
+  if (evidence_) evidence_->addFrame(sequence, time_s, fingerprint);
   SegmenterStep step = segmenter_.addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   if (motion_counters_ != nullptr) {
     const MotionUse use = last_motion_.known ? MotionUse::Used : gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
@@ -103,6 +109,7 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
     place.representative_frame = p.representative_frame;
     place.keypoints = p.representative_keypoints;
     place.representative = p.representative;
+    if (evidence_) place.evidence = evidence_->closePlace(p.first_frame, p.last_frame);
     const auto it = std::find_if(thumbnails_.begin(), thumbnails_.end(),
                                  [&](const auto& entry) { return entry.first == p.representative_frame; });
     if (it != thumbnails_.end()) place.thumbnail = it->second;
@@ -135,6 +142,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   // The application data lists the representative frames of the run that saved the map; frame numbers of
   // an older run mean nothing in this one, so resumed observations show -1.
   representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);
+  run_first_observation_ = filter_->observationCount();
   revision_ = 1;
   refresh();
 }
@@ -142,6 +150,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
 void ParticleFilterTopologyStage::enqueuePlace(const ClosedPlace& place) {
   queue_.push_back(place.representative);
   queued_frames_.push_back(place.representative_frame);
+  queued_evidence_.push_back(place.evidence);
 }
 
 std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budget_s) {
@@ -149,8 +158,13 @@ std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budge
   do {
     if (!filter_->stepInProgress()) {
       if (queue_.empty()) return std::nullopt;
-      filter_->beginStep(queue_.front());
+      // Evidence by earlier place of this run -> by filter observation.
+      const std::vector<double>& by_place = queued_evidence_.front();
+      step_evidence_.assign(by_place.empty() ? 0 : static_cast<std::size_t>(run_first_observation_), 0.0);
+      step_evidence_.insert(step_evidence_.end(), by_place.begin(), by_place.end());
+      filter_->beginStep(queue_.front(), step_evidence_);
       queue_.pop_front();
+      queued_evidence_.pop_front();
     }
     if (filter_->advance(slice_items_)) {
       representative_frames_.push_back(queued_frames_.front());

@@ -50,8 +50,14 @@ OfflineMapper::OfflineMapper(const VpackExtractor& extractor, const SimilarityMe
   }
 }
 
+void OfflineMapper::useSequenceEvidence(const SequenceEvidenceConfig& config) {
+  if (!finished_.frames.empty() || current_) throw std::logic_error("OfflineMapper: sequence evidence after the first frame");
+  evidence_ = config.weight > 0.0 ? std::make_unique<PlaceSequenceEvidence>(config, similarity_) : nullptr;
+}
+
 void OfflineMapper::beginTraversal() {
   if (current_) finish();
+  if (evidence_) evidence_->beginTraversal();
   current_ = std::make_unique<OfflineSegmentation>(extractor_, similarity_, config_);
   ++traversal_count_;
 }
@@ -70,8 +76,10 @@ SegmentedPlace OfflineMapper::toRunNumbering(SegmentedPlace place) const {
 SegmenterStep OfflineMapper::segment(double time_s, const std::string& name,
                                      std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
   if (!current_) beginTraversal();
+  const std::shared_ptr<const Fingerprint> for_evidence = evidence_ ? fingerprint : nullptr;
   SegmenterStep step = current_->segment(time_s, name, std::move(fingerprint), motion);
   step.frame += static_cast<std::int64_t>(finished_.frames.size());
+  if (evidence_) evidence_->addFrame(step.frame, time_s, for_evidence);
   if (step.closed_place) step.closed_place = toRunNumbering(std::move(*step.closed_place));
   return step;
 }
@@ -79,7 +87,15 @@ SegmenterStep OfflineMapper::segment(double time_s, const std::string& name,
 std::optional<MappedPlace> OfflineMapper::mapPlace(const SegmentedPlace& place) {
   if (place.dropped) return std::nullopt;
   if (!place.representative) throw std::invalid_argument("OfflineMapper::mapPlace: place without a representative");
-  filter_.step(place.representative);
+  if (evidence_) {
+    // Evidence by kept place of this run; the filter numbers observations from the map's first one.
+    const std::vector<double> by_place = evidence_->closePlace(place.first_frame, place.last_frame);
+    std::vector<double> by_observation(static_cast<std::size_t>(first_observation_), 0.0);
+    by_observation.insert(by_observation.end(), by_place.begin(), by_place.end());
+    filter_.step(place.representative, by_observation);
+  } else {
+    filter_.step(place.representative);
+  }
   MappedPlace mapped{place, filter_.estimate(3)};
   mapped.place.representative.reset();  // the filter keeps what it needs
   steps_.push_back(mapped);

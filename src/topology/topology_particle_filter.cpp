@@ -217,9 +217,15 @@ void TopologyParticleFilter::relativeLikelihoods() {
   }
 }
 
-void TopologyParticleFilter::beginStep(std::shared_ptr<const Fingerprint> representative) {
+void TopologyParticleFilter::beginStep(std::shared_ptr<const Fingerprint> representative,
+                                       std::span<const double> evidence) {
   if (phase_ != Phase::Idle) throw std::logic_error("TopologyParticleFilter: a step is already in progress");
   if (!representative) throw std::invalid_argument("TopologyParticleFilter: null representative");
+  if (evidence.size() > idx(observation_count_))
+    throw std::invalid_argument("TopologyParticleFilter: evidence for " + std::to_string(evidence.size()) +
+                                " observations, only " + std::to_string(observation_count_) + " made");
+  evidence_.assign(evidence.begin(), evidence.end());
+  for (double& e : evidence_) e = std::isfinite(e) ? std::clamp(e, 0.0, 1.0) : 0.0;
   if (observation_count_ == std::numeric_limits<std::int32_t>::max())
     throw std::length_error("too many observations");
   pending_ = std::move(representative);
@@ -276,6 +282,8 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           similarity_of_[o] = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
         }
         if (config_.likelihood == LikelihoodModel::Relative) relativeLikelihoods();
+        for (const std::int32_t o : needed_list_)
+          if (idx(o) < evidence_.size()) similarity_of_[idx(o)] = std::max(similarity_of_[idx(o)], evidence_[idx(o)]);
         phase_ = Phase::Aggregate;
         cursor_ = 0;
         break;
@@ -399,8 +407,8 @@ void TopologyParticleFilter::finishStep() {
   cursor_ = 0;
 }
 
-void TopologyParticleFilter::step(std::shared_ptr<const Fingerprint> representative) {
-  beginStep(std::move(representative));
+void TopologyParticleFilter::step(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence) {
+  beginStep(std::move(representative), evidence);
   while (!advance(std::numeric_limits<std::size_t>::max())) {
   }
 }

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -93,4 +94,48 @@ TEST_CASE("GIVEN a size bound WHEN frames exceed it THEN the recorder stops at t
   CHECK(recorder.bytes() == 2 * one);
   CHECK_FALSE(fs::exists(dir / "000002.png"));
   CHECK(openFrameSource("images:" + dir.string())->frameCountHint() == 2);
+}
+
+namespace {
+
+/// Frames with the given timestamps, at once.
+class ListedTimesSource final : public FrameSource {
+ public:
+  explicit ListedTimesSource(std::vector<double> times) : times_(std::move(times)) {}
+  std::string describe() const override { return "listed times"; }
+  std::optional<Frame> next() override {
+    if (next_ >= times_.size()) return std::nullopt;
+    Frame frame = frameAt(static_cast<std::int64_t>(next_), times_[next_]);
+    ++next_;
+    return frame;
+  }
+  void interrupt() override {}
+
+ private:
+  std::vector<double> times_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE(
+    "GIVEN a recording whose clock steps back 30 s WHEN played at the recorded rate THEN the frame after the "
+    "step comes one frame interval later, not at once, and keeps its timestamp",
+    "[io][record][reliability]") {
+  // 0.4 s apart; the third frame's clock stepped back 30 s (docs/reliability.md, "Clock jumps").
+  const std::unique_ptr<FrameSource> replay =
+      makeRecordedRateSource(std::make_unique<ListedTimesSource>(std::vector<double>{100.0, 100.4, 70.8, 71.2}));
+  std::vector<double> delivered_at, stamps;
+  const auto start = std::chrono::steady_clock::now();
+  while (std::optional<Frame> frame = replay->next()) {
+    delivered_at.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    stamps.push_back(frame->timestamp_s);
+  }
+  REQUIRE(delivered_at.size() == 4);
+  CHECK(stamps == std::vector<double>{100.0, 100.4, 70.8, 71.2});
+  // Lower bounds only (a slow machine delivers later, never earlier): before, the frame after the step was
+  // due at once, with the frame before it.
+  CHECK(delivered_at[2] - delivered_at[1] >= 0.35);
+  CHECK(delivered_at[3] - delivered_at[2] >= 0.35);
+  CHECK(delivered_at[3] >= 1.15);
 }

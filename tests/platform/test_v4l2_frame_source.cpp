@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -338,6 +339,29 @@ SCENARIO(
     CHECK(rig.state.opens == 2);
     CHECK(rig.state.streamons == 2);
   }
+}
+
+SCENARIO(
+    "GIVEN the default backoff and a camera away for 20 attempts WHEN it comes back THEN no wait between "
+    "attempts was over 0.5 s: a camera plugged back is reopened within 0.5 s (resume within 2 s)",
+    "[reliability]") {
+  Rig rig;
+  auto config = smallConfig();
+  const V4l2SourceConfig defaults;
+  config.reconnect_initial_ms = defaults.reconnect_initial_ms;
+  config.reconnect_max_ms = defaults.reconnect_max_ms;
+  rig.open(config);
+  rig.state.events.push_back(errorEvent(Kind::DqbufError, ENODEV));
+  rig.state.open_errors = std::deque<int>(20, ENOENT);
+  rig.state.events.push_back(frameEvent(yuyv(kWidth, kHeight, 128, 128, 128), 0));
+  const auto after = rig.drain();
+  REQUIRE(after.size() == 1);
+  REQUIRE(rig.sleeps.size() == 21);
+  using std::chrono::milliseconds;
+  // 100, 200, 400, then the ceiling: it was 2000 ms, so a camera back just after an attempt waited 2 s.
+  CHECK(rig.sleeps[2] == milliseconds(400));
+  CHECK(*std::max_element(rig.sleeps.begin(), rig.sleeps.end()) == milliseconds(500));
+  CHECK(rig.source->status().reconnects == 1);
 }
 
 SCENARIO("GIVEN POLLHUP WHEN capturing THEN the status shows reconnecting until the camera is back") {

@@ -158,3 +158,98 @@ TEST_CASE("sequence loop closures: bad settings and input are refused, naming wh
   CHECK_THROWS_AS(matchFramesBySequence({0.0, 1.0}, {test::taggedFingerprint(0)}, similarity, SequenceLoopConfig{}),
                   std::invalid_argument);
 }
+
+TEST_CASE("place sequence evidence: a retraced lap points each place at its first-lap twin, the first lap at nothing",
+          "[sequence_loops][evidence]") {
+  // 1 Hz keyframes, two laps of 60 s cut into places of 15 s; the second lap retraces the first.
+  const int lap = 60, place_length = 15;
+  const test::TagSimilarity similarity = lapSimilarity();
+  SequenceEvidenceConfig config;
+  config.weight = 0.99;
+  config.loop.decay = 0.9;
+  PlaceSequenceEvidence evidence(config, similarity);
+  std::vector<std::vector<double>> by_place;
+  for (int traversal = 0; traversal < 2; ++traversal) {
+    if (traversal == 1) evidence.beginTraversal();
+    for (int i = 0; i < lap; ++i) {
+      const std::int64_t frame = traversal * lap + i;
+      evidence.addFrame(frame, static_cast<double>(i), test::taggedFingerprint(i));
+      if ((i + 1) % place_length == 0) by_place.push_back(evidence.closePlace(frame - place_length + 1, frame));
+    }
+  }
+  REQUIRE(by_place.size() == 8u);
+  CHECK(evidence.keyframes() == 2 * lap);
+  for (std::size_t p = 0; p < 8; ++p) {
+    REQUIRE(by_place[p].size() == p);  // one value per earlier place
+    if (p < 4) {
+      for (const double e : by_place[p]) CHECK(e == 0.0);  // the first lap has no twin
+      continue;
+    }
+    // Place p of the second lap: every keyframe after the first few detects into place p - 4.
+    for (std::size_t q = 0; q < p; ++q) {
+      if (q == p - 4) {
+        CHECK(by_place[p][q] >= 0.99 * 0.8);
+        CHECK(by_place[p][q] <= 0.99);
+      } else {
+        CHECK(by_place[p][q] == 0.0);
+      }
+    }
+  }
+}
+
+TEST_CASE("place sequence evidence: a share below min_share gives nothing, a dropped place's keyframes do not count",
+          "[sequence_loops][evidence]") {
+  const test::TagSimilarity similarity = lapSimilarity();
+  // Frames 0..29 (tags 0..29); 30..39 retrace 0..9 and 40..49 are new (tags 140..149), closed as one place
+  // with about half its keyframes on place 0; 50..59 retrace 10..19 in a dropped place (never closed);
+  // 60..69 retrace 20..29, all of them on place 0.
+  const auto run = [&](double min_share) {
+    SequenceEvidenceConfig config;
+    config.weight = 0.5;
+    config.loop.decay = 0.9;
+    config.loop.min_gap_keyframes = 10;
+    config.min_share = min_share;
+    PlaceSequenceEvidence evidence(config, similarity);
+    for (int i = 0; i < 30; ++i) evidence.addFrame(i, i, test::taggedFingerprint(i));
+    std::vector<std::vector<double>> out{evidence.closePlace(0, 29)};
+    for (int i = 30; i < 40; ++i) evidence.addFrame(i, i, test::taggedFingerprint(i - 30));
+    for (int i = 40; i < 50; ++i) evidence.addFrame(i, i, test::taggedFingerprint(100 + i));
+    out.push_back(evidence.closePlace(30, 49));
+    for (int i = 50; i < 70; ++i) evidence.addFrame(i, i, test::taggedFingerprint(i - 40));
+    out.push_back(evidence.closePlace(60, 69));
+    return out;
+  };
+  const std::vector<std::vector<double>> strict = run(0.8), loose = run(0.0);
+  CHECK(strict[0].empty());
+  REQUIRE(strict[1].size() == 1u);
+  REQUIRE(loose[1].size() == 1u);
+  CHECK(loose[1][0] >= 0.5 * 0.5);  // at least the ten retraced keyframes of twenty
+  CHECK(loose[1][0] < 0.5 * 0.8);
+  CHECK(strict[1][0] == 0.0);       // ... below the share that counts
+  REQUIRE(strict[2].size() == 2u);
+  CHECK_THAT(strict[2][0], WithinAbs(0.5, 1e-12));  // ten of ten keyframes, the dropped place's not counted
+  CHECK(strict[2][1] == 0.0);
+}
+
+TEST_CASE("place sequence evidence: bad settings and input are refused", "[sequence_loops][evidence]") {
+  SequenceEvidenceConfig config;
+  config.weight = 1.5;
+  CHECK_THAT(config.validate(), Contains("weight"));
+  config = {};
+  config.min_share = -0.1;
+  CHECK_THAT(config.validate(), Contains("share"));
+  config = {};
+  config.min_score = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THAT(config.validate(), Contains("score"));
+  config = {};
+  config.loop.decay = 1.0;
+  CHECK_THAT(config.validate(), Contains("decay"));
+  const test::TagSimilarity similarity = lapSimilarity();
+  CHECK_THROWS_AS(PlaceSequenceEvidence(config, similarity), std::invalid_argument);
+  PlaceSequenceEvidence evidence(SequenceEvidenceConfig{}, similarity);
+  evidence.addFrame(5, 0.0, test::taggedFingerprint(0));
+  CHECK_THROWS_WITH(evidence.addFrame(5, 1.0, test::taggedFingerprint(1)), Contains("after frame 5"));
+  CHECK_THROWS_AS(evidence.closePlace(3, 2), std::invalid_argument);
+  evidence.closePlace(0, 5);
+  CHECK_THROWS_WITH(evidence.closePlace(5, 9), Contains("overlaps"));
+}

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -349,4 +351,36 @@ TEST_CASE(
     run(with_absolute, places);
     CHECK(with_absolute.estimate().best.node_count == 16);  // every place a new node: no closure
   }
+}
+
+TEST_CASE("GIVEN evidence from outside the representatives WHEN a step takes it THEN a revisit the appearance cannot "
+          "tell wins, and bad evidence is refused",
+          "[topology][evidence]") {
+  // Every representative looks the same to the similarity (0.3): on appearance alone the third observation
+  // cannot tell observation 0's node from a new one. Sequence evidence 0.99 on observation 0 decides it.
+  const test::TagSimilarity flat([](int, int) { return 0.3; });
+  TopologyFilterConfig config;
+  config.particles = 200;
+  config.likelihood = LikelihoodModel::Relative;
+  config.relative_slope = 2.0;
+  config.relative_offset = 8.0;
+  const auto run = [&](bool with_evidence) {
+    TopologyParticleFilter filter(config, flat);
+    filter.step(test::taggedFingerprint(0));
+    filter.step(test::taggedFingerprint(1));
+    const std::vector<double> evidence{0.99, 0.0};
+    filter.step(test::taggedFingerprint(2), with_evidence ? std::span<const double>(evidence) : std::span<const double>());
+    return filter.estimate(0).best.assignment;
+  };
+  CHECK(run(false) == std::vector<int>{0, 1, 2});
+  CHECK(run(true) == std::vector<int>{0, 1, 0});
+
+  TopologyParticleFilter filter(config, flat);
+  filter.step(test::taggedFingerprint(0));
+  const std::vector<double> too_long{0.5, 0.5};
+  CHECK_THROWS_WITH(filter.beginStep(test::taggedFingerprint(1), too_long), Catch::Matchers::Contains("evidence for 2 observations"));
+  // Not finite or out of [0, 1]: clamped, never a NaN weight.
+  const std::vector<double> odd{std::numeric_limits<double>::quiet_NaN()};
+  filter.step(test::taggedFingerprint(1), odd);
+  CHECK(filter.observationCount() == 2);
 }

@@ -1,16 +1,18 @@
 # Sourced by tests/vm/guest.sh inside the VM (uses its pass/fail/step/show helpers, $toposlamd, the
 # running ffmpeg writer on /dev/video0 and the `toposlam listen` subscriber started early as $listener):
-# runs the real toposlamd on the v4l2loopback camera for 30 s, stops it with SIGTERM and checks that
+# runs the real toposlamd on the v4l2loopback camera for 30 s (stretched by the slowness), stops it with
+# SIGTERM and checks that
 #   - it exits 0 (clean stop: the filter step finished, the map saved) and the map file exists;
 #   - place estimates (TOPOSLAM_PLACE, one per processed frame) arrived over LCM (multicast on lo), each
 #     with a frame number, a place and a node (-1 before the first place), frame numbers increasing;
 #     the estimates after a place event name a node >= 0;
 #   - status messages arrived and say the camera is streaming.
-step "toposlamd on v4l2loopback + LCM"
+step 75 "toposlamd on v4l2loopback + LCM"
+run_s=$(s 30)
 rm -f /tmp/vm-map.tsm
 # --preserve-status: the exit code is toposlamd's own after the SIGTERM (not timeout's 124); -k: a daemon
 # that hangs on SIGTERM is killed 20 s later (137) and fails the check below.
-timeout --preserve-status -k 20 -s TERM 30 "$toposlamd" --source "v4l2:/dev/video0?size=320x240&fps=10&format=yuyv" \
+timeout --preserve-status -k "$(s 20)" -s TERM "$run_s" "$toposlamd" --source "v4l2:/dev/video0?size=320x240&fps=10&format=yuyv" \
   --map /tmp/vm-map.tsm --no-map-load >daemon.txt 2>&1
 daemon_rc=$?
 sleep 1  # the last status/flush messages on their way over lo
@@ -20,7 +22,7 @@ events=$(grep -c '^EVENT ' listen.txt)
 statuses=$(grep -c '^STATUS ' listen.txt)
 show daemon daemon.txt 400 | tail -6
 grep -E '^(place|EVENT|STATUS) ' listen.txt | tail -3 | sed 's/^/  listen| /'
-echo "VMTEST toposlamd exit $daemon_rc after SIGTERM at 30 s: $places place, $events place-event, $statuses status messages received"
+echo "VMTEST toposlamd exit $daemon_rc after SIGTERM at $run_s s: $places place, $events place-event, $statuses status messages received"
 
 if [ "$daemon_rc" -eq 0 ]; then
   pass "toposlamd stopped cleanly on SIGTERM (exit 0)"

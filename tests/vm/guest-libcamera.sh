@@ -15,11 +15,11 @@ libcamera_start() {
   done
   (
     export LIBCAMERA_LOG_LEVELS='*:ERROR'  # not its warnings about vimc's sensor having no properties
-    timeout 60 cam --list >cam-list.txt 2>&1
+    timeout "$(s 60)" cam --list >cam-list.txt 2>&1
     camera_id=$(sed -n "s/^[0-9]*: '.*' (\(.*\))$/\1/p" cam-list.txt | grep vimc | head -n 1)
     echo "$camera_id" >camera-id.txt
     [ -n "$camera_id" ] &&
-      timeout 90 "$toposlam" capture "libcamera:$camera_id?size=240x180" -n 30 --timeout 75 >libcamera.txt 2>&1
+      timeout "$(s 90)" "$toposlam" capture "libcamera:$camera_id?size=240x180" -n 30 --timeout "$(s 75)" >libcamera.txt 2>&1
   ) &
   libcamera_job=$!
 }

@@ -3,12 +3,12 @@
 # v4l2loopback, vivid and vimc loaded, shares this machine's root read-only over 9p and runs the real
 # toposlam binaries from BUILD_DIR inside (tests/vm/guest.sh). Passes when every guest check passed.
 # Exit 77 (skipped) only when QEMU cannot run here at all (no qemu-system-x86_64).
-# The whole test (boot + guest, plus preparing the cache when ctest's vm_prepare_kernel fixture did not
-# already) must finish within TOPOSLAM_VM_BUDGET seconds (default 175; ctest stops it at 180): the VM gets
-# what the preparation left of it, and a test over budget fails.
+# Time: no fixed budget. tests/vm/watch-guest.sh follows the guest: the boot must come within 120 s, and
+# each guest step within its own limit for an idle machine times the slowness the guest's boot measured
+# (tests/vm/budget.sh), so a busy machine stretches the limits and a hang still fails, naming its step.
 # Usage: tests/vm/run-vm-test.sh BUILD_DIR [CACHE_DIR]    (CACHE_DIR default BUILD_DIR/vm-cache)
-# Environment: TOPOSLAM_VM_BUDGET (seconds for the whole test, default 175),
-#              TOPOSLAM_VM_TIMEOUT (seconds for boot-to-poweroff, default: what is left of the budget),
+# Environment: TOPOSLAM_VM_BOOT_LIMIT (host seconds for the boot, default 120),
+#              TOPOSLAM_VM_SLOWNESS (the factor instead of the one measured),
 #              TOPOSLAM_VM_SMP (guest CPUs, default 2),
 #              TOPOSLAM_VM_DAEMON (another toposlamd binary to run inside instead of BUILD_DIR's).
 set -euo pipefail
@@ -37,29 +37,27 @@ prepared=$(date +%s)
 echo "vm-test: kernel $kver prepared in $((prepared - started)) s; booting"
 
 log="$build/vm-test.log"
-budget_s=${TOPOSLAM_VM_BUDGET:-175}
-left_s=$((budget_s - (prepared - started) - 5))  # 5 s for qemu's own exit and this script
-[ "$left_s" -ge 60 ] || { echo "vm-test: FAILED: preparing took $((prepared - started)) s, leaving $left_s s of the ${budget_s} s budget"; exit 1; }
-timeout_s=${TOPOSLAM_VM_TIMEOUT:-$left_s}
+: >"$log"
 set +e
-timeout --kill-after=5 "$timeout_s" "$qemu" -accel tcg -m 1024 -smp "${TOPOSLAM_VM_SMP:-2}" \
+"$qemu" -accel tcg -m 1024 -smp "${TOPOSLAM_VM_SMP:-2}" \
   -kernel "$cache/vmlinuz" -initrd "$initrd" \
   -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
   -append "console=ttyS0 quiet loglevel=3 panic=-1 tsguest=$here/guest.sh tsbuild=$build${TOPOSLAM_VM_DAEMON:+ tsdaemon=$TOPOSLAM_VM_DAEMON}" \
-  -nographic -no-reboot -monitor none -serial stdio </dev/null >"$log" 2>&1
+  -nographic -no-reboot -monitor none -serial stdio </dev/null >"$log" 2>&1 &
+qemu_pid=$!
+trap 'kill -KILL $qemu_pid 2>/dev/null' EXIT  # ctest's own timeout, or ^C: no QEMU left behind
+"$here/watch-guest.sh" "$log" "$qemu_pid"
+watch_rc=$?
+wait "$qemu_pid"
 qemu_rc=$?
 set -e
+trap - EXIT
 finished=$(date +%s)
 tr -d '\r' <"$log" | grep -oE "VMTEST .*|^  [a-z0-9]+\| .*" | grep -v "| frame seq=" || true
 echo "vm-test: guest ran $((finished - prepared)) s (qemu exit $qemu_rc), whole test $((finished - started)) s; log $log"
 
-if [ "$qemu_rc" -eq 124 ] || [ "$qemu_rc" -eq 137 ]; then
-  echo "vm-test: FAILED: the VM did not power off within $timeout_s s"; exit 1
-fi
+[ "$watch_rc" -eq 0 ] || { echo "vm-test: FAILED: stopped by the watcher (see above and $log)"; exit 1; }
 grep -q "VMTEST BOOTED" "$log" || { echo "vm-test: FAILED: the guest did not boot (see $log)"; exit 1; }
 grep -q "VMTEST DONE failures=0" "$log" || { echo "vm-test: FAILED: guest checks failed"; exit 1; }
 if grep -q "VMTEST FAIL" "$log"; then echo "vm-test: FAILED"; exit 1; fi
-if [ $((finished - started)) -gt "$budget_s" ]; then
-  echo "vm-test: FAILED: took $((finished - started)) s, over the ${budget_s} s budget"; exit 1
-fi
 echo "vm-test: PASSED"

@@ -13,6 +13,7 @@
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -69,6 +70,7 @@ struct DaemonConfig {
   FiedlerSegmenterConfig segmentation;
   MotionGateConfig segmentation_motion;  ///< segmentation.motion: when TOPOSLAM_MOTION says the robot stands
   TopologyFilterConfig topology;
+  SequenceEvidenceConfig sequence_evidence;  ///< from the preset (docs/topology.md); weight 0 in "thesis"
   int topology_slice_items = 256;  ///< topology.slice_items: work items per advance() slice, 1 .. 1000000
   int topology_alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
 

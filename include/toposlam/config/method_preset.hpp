@@ -16,6 +16,7 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -26,6 +27,8 @@ struct MethodPreset {
   NgramSimilarityConfig similarity;
   FiedlerSegmenterConfig segmentation;
   TopologyFilterConfig topology;
+  /// The filter's second source of evidence, runs of frames (docs/topology.md); off (weight 0) in both.
+  SequenceEvidenceConfig sequence_evidence;
 };
 
 /// "default" or "thesis"; throws std::invalid_argument naming the allowed names otherwise.

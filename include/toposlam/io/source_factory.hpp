@@ -37,8 +37,8 @@ std::unique_ptr<FrameSource> openFrameSource(const std::string& uri);
 std::unique_ptr<FrameSource> makeRateLimitedSource(std::unique_ptr<FrameSource> inner, double rate_hz);
 
 /// Wraps a source so next() returns each frame no earlier than its timestamp minus the first frame's
-/// after the first call: the pace it was recorded at (gaps included; a timestamp going back is due at
-/// once). Timestamps are left as they are.
+/// after the first call: the pace it was recorded at (gaps included; a timestamp going back is due one
+/// typical frame interval after the frame before, FrameTimeline). Timestamps are left as they are.
 std::unique_ptr<FrameSource> makeRecordedRateSource(std::unique_ptr<FrameSource> inner);
 
 /// True when `uri` asks for rate=recorded (the openers then leave `rate` to openFrameSource).

@@ -66,7 +66,9 @@ struct V4l2SourceConfig {
   int buffer_count = 4;            ///< mmap buffers requested (REQBUFS), 2..32
   int poll_timeout_ms = 200;       ///< longest poll() slice; interrupt() is noticed within this time
   int reconnect_initial_ms = 100;  ///< first backoff after an unplug, doubled per failed attempt
-  int reconnect_max_ms = 2000;     ///< backoff ceiling
+  /// Backoff ceiling: a camera plugged back is reopened within this (plus the opening), so the daemon
+  /// resumes within 2 s of the device's return (issue 19); an attempt on a missing node costs one open().
+  int reconnect_max_ms = 500;
   int reconnect_max_attempts = 0;  ///< give up (FrameSourceError) after this many; 0 = never
   bool wait_at_start = false;      ///< a missing device node at start: reconnect instead of failing
 

@@ -13,11 +13,13 @@
 #include <utility>
 #include <vector>
 
+#include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/stages.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/topology/map_store.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -48,13 +50,21 @@ struct MotionSample {
 /// dropped) so the closed place's representative has its picture. Dropped places (too few keypoints) are
 /// counted and not passed on.
 ///
+/// The window's clock is the frames' source time through a FrameTimeline: a source time that goes back
+/// (a recording's clock stepped back, broken video PTS) is carried on from the previous frame at the
+/// typical interval and counted (sourceTimeStepsBack()), logged now and then; a jump forward is a gap
+/// (docs/reliability.md, "Clock jumps").
+///
 /// Motion (docs/segmentation.md, "Motion-aware segmentation"): samples given to addMotion() (any thread)
 /// are applied to a MotionGate, in order, before the next frame; each frame then asks the gate at its
 /// captured_at_s. Without samples the segmentation is exactly the one without motion.
 class FiedlerSegmentationStage final : public SegmentationStage {
  public:
+  /// `evidence` with weight > 0: every closed place carries the sequence evidence of its frames
+  /// (ClosedPlace::evidence; docs/topology.md). The default has weight 0: none.
   FiedlerSegmentationStage(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity,
-                           std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {});
+                           std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {},
+                           const SequenceEvidenceConfig& evidence = {});
   SegmentationStep process(std::int64_t sequence, double source_time_s, double captured_at_s, std::shared_ptr<const Fingerprint> fingerprint,
                            const cv::Mat& thumbnail) override;
   std::optional<ClosedPlace> finish() override;
@@ -70,6 +80,9 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::int64_t skippedFrames() const { return segmenter_.skippedFrames(); }
   std::int64_t refusedMotionSamples() const { return gate_.rejectedSamples(); }
   std::int64_t droppedMotionSamples() const;
+  /// Segmentation thread (or after it ended): frames whose source time went back, which the window's
+  /// clock carried on from the frame before (FrameTimeline).
+  std::int64_t sourceTimeStepsBack() const { return timeline_.stepsBack(); }
   /// From now on, every frame writes whether motion is used and the standing frames so far into
   /// `counters` (may be null: nowhere), which must outlive the stage; any thread may read them.
   void reportMotionTo(MotionStatusCounters* counters) { motion_counters_ = counters; }
@@ -80,6 +93,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   std::optional<ClosedPlace> toClosedPlace(const SegmentedPlace& place);
 
   FiedlerSegmenter segmenter_;
+  std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: no sequence evidence
   std::size_t max_thumbnails_;
   /// (frame, thumbnail) of the open place's frames, in arrival order; capacity max_thumbnails_ reserved
   /// once, so a frame costs no node allocation.
@@ -88,7 +102,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 
   MotionGate gate_;
   MotionState last_motion_;
-  double last_source_time_s_ = -std::numeric_limits<double>::infinity();  ///< the window's clock so far
+  FrameTimeline timeline_;  ///< the window's clock: source times with their steps back cut out
   mutable std::mutex motion_mutex_;
   std::deque<MotionSample> pending_motion_;  ///< guarded by motion_mutex_
   std::deque<MotionSample> applying_;        ///< segmentation thread: swapped out of pending_motion_
@@ -133,6 +147,9 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   std::deque<std::shared_ptr<const Fingerprint>> queue_;  ///< representatives waiting for their step
   std::vector<std::int64_t> representative_frames_;        ///< per observation (-1: from an older run)
   std::deque<std::int64_t> queued_frames_;
+  std::deque<std::vector<double>> queued_evidence_;  ///< per queued place: by earlier place of this run
+  int run_first_observation_ = 0;  ///< observation of this run's first place (after a loaded map)
+  std::vector<double> step_evidence_;  ///< scratch: the evidence by observation
   std::int64_t revision_ = 0;
   PlaceEstimate estimate_;
   TopologySnapshot topology_;

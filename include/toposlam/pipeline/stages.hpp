@@ -31,6 +31,9 @@ struct ClosedPlace {
   int keypoints = 0;                      ///< keypoints of the representative
   std::shared_ptr<const Fingerprint> representative;
   cv::Mat thumbnail;                      ///< small BGR image of the representative (may be empty)
+  /// Sequence evidence (PlaceSequenceEvidence), one likelihood per earlier place of this run in closing
+  /// order; empty when the segmentation stage has none.
+  std::vector<double> evidence;
 };
 
 /// What segmentation says after one frame.

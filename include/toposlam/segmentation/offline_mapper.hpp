@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -34,6 +35,11 @@ class OfflineMapper {
   /// observations (a resumed map). Throws std::invalid_argument on a bad segmentation config.
   OfflineMapper(const VpackExtractor& extractor, const SimilarityMeasure& similarity,
                 const FiedlerSegmenterConfig& config, TopologyParticleFilter& filter);
+
+  /// From now on, every filter step also gets the sequence evidence of the place's frames
+  /// (PlaceSequenceEvidence; docs/topology.md). Call before the first frame; weight 0 turns it off.
+  /// Throws std::invalid_argument on a bad config.
+  void useSequenceEvidence(const SequenceEvidenceConfig& config);
 
   /// Starts the next traversal (a fresh segmentation window); the first one starts implicitly. An open
   /// traversal is finished first (its last place is mapped).
@@ -81,6 +87,7 @@ class OfflineMapper {
   int first_observation_ = 0;
   int traversal_count_ = 0;
   std::unique_ptr<OfflineSegmentation> current_;  ///< the open traversal, null between traversals
+  std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: the representatives alone
   SegmentationRun finished_;                      ///< traversals already closed, run numbering
   std::vector<MappedPlace> steps_;
 };

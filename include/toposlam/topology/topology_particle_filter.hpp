@@ -178,15 +178,18 @@ class TopologyParticleFilter {
   TopologyParticleFilter& operator=(const TopologyParticleFilter&) = delete;
 
   /// Starts the step for a new representative. Throws std::logic_error while a step is in progress and
-  /// std::invalid_argument for a null fingerprint.
-  void beginStep(std::shared_ptr<const Fingerprint> representative);
+  /// std::invalid_argument for a null fingerprint or more evidence values than observations.
+  /// `evidence` (optional): per earlier observation, a likelihood in [0, 1] from outside the
+  /// representatives (PlaceSequenceEvidence); a stored representative's likelihood is then the larger of
+  /// its own and its observation's evidence. Empty: the representatives alone (the thesis).
+  void beginStep(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence = {});
   /// Runs at most `budget` work items of the current step (>= 1; one item = one similarity evaluation,
   /// one distinct topology scanned or aggregated, or one particle proposed/weighted/updated). Returns
   /// true when the step is complete (also when no step is in progress). Sliced and whole runs of a step
   /// give identical results.
   bool advance(std::size_t budget);
   /// beginStep + advance until done.
-  void step(std::shared_ptr<const Fingerprint> representative);
+  void step(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence = {});
   bool stepInProgress() const { return phase_ != Phase::Idle; }
 
   const TopologyFilterConfig& config() const { return config_; }
@@ -242,6 +245,7 @@ class TopologyParticleFilter {
   std::vector<unsigned char> needed_;   ///< per observation: referenced by some group
   std::vector<std::int32_t> needed_list_;
   std::vector<double> similarity_of_;  ///< per observation, this step
+  std::vector<double> evidence_;       ///< per observation, this step (beginStep's; may be shorter)
   struct GroupStats {
     double max = 0.0;
     double new_likelihood = 1.0;

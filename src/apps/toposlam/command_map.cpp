@@ -67,6 +67,10 @@ struct MapOptions {
   CLI::Option* frame_loops_given = nullptr;
   int loop_min_gap = 10;  ///< visits: detections at least this many frames back
   SequenceLoopConfig sequence_loops;  ///< sequence: keyframes, decay, gap
+  double sequence_evidence = -1.0;   ///< -1: the preset's weight
+  double sequence_evidence_min_score = SequenceEvidenceConfig{}.min_score;
+  double sequence_evidence_min_relative = SequenceEvidenceConfig{}.min_relative;
+  double sequence_evidence_min_share = SequenceEvidenceConfig{}.min_share;
   double loop_min_gap_s = 20.0;       ///< sequence: detections at least this long back
   int max_keypoints = -1;             ///< -1: the preset's
   std::string likelihood = toString(methodPreset("default").topology.likelihood);
@@ -203,6 +207,14 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const int first_observation = filter->observationCount();
 
   OfflineMapper mapper(extractor, similarity, segmenter_config, *filter);
+  SequenceEvidenceConfig evidence = preset.sequence_evidence;
+  evidence.loop = sequence_loops;
+  if (o.sequence_evidence >= 0.0) evidence.weight = o.sequence_evidence;
+  evidence.min_score = o.sequence_evidence_min_score;
+  evidence.min_relative = o.sequence_evidence_min_relative;
+  evidence.min_share = o.sequence_evidence_min_share;
+  if (const std::string problem = evidence.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
+  mapper.useSequenceEvidence(evidence);
   std::vector<FrameTiming> timing;
   std::int64_t refused = 0;
   // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
@@ -227,6 +239,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::unique_ptr<FrameSource> source = openSource(uri);
     std::cerr << "map: " << source->describe() << "\n";
     mapper.beginTraversal();  // fresh segmentation window per traversal
+    // Each traversal's own clock, with any step back inside it cut out (docs/reliability.md, "Clock
+    // jumps"); the next source starts its own, so where it goes back a new traversal begins (frames.csv).
+    FrameTimeline timeline;
     Progress source_progress("map", "frames", source->frameCountHint());
     progress = &source_progress;
     std::int64_t read = 0;
@@ -250,7 +265,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
       const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
-      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint), moving);
+      const SegmenterStep step = mapper.segment(timeline.place(frame->timestamp_s), name, std::move(fingerprint), moving);
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
@@ -261,6 +276,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     progress = nullptr;
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
+    if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "map") << "\n";
   }
   if (motion) std::cerr << motionSummary(*motion, o.motion, "map") << "\n";
   const SegmentationRun all = mapper.run();
@@ -301,6 +317,10 @@ void runMap(const MapOptions& o, bool filter_options_given) {
                       {"topology.particles", std::to_string(topo.particles)},
                       {"topology.likelihood", toString(topo.likelihood)},
                       {"topology.seed", std::to_string(topo.seed)},
+                      {"topology.sequence_evidence",
+                       evidence.weight > 0.0 ? "weight " + real(evidence.weight) + ", detections scored at least " +
+                                                   real(evidence.min_score)
+                                             : "off"},
                       {"frame_loops", by_sequence ? "sequence, decay " + real(sequence_loops.decay) + ", at least " +
                                                         real(o.loop_min_gap_s) + " s back"
                                                   : "visits, at least " + std::to_string(o.loop_min_gap) +
@@ -529,6 +549,22 @@ void addMapCommand(CLI::App& app) {
                   "Frame-level loop closures (sequence): one keyframe at most this often")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--sequence-evidence", options->sequence_evidence,
+                  "Filter: likelihood of an earlier place that every keyframe of the new place detects into (the "
+                  "sequence detector's evidence, docs/topology.md; 0.99 turns it on; default: the preset's, off)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--sequence-evidence-min-score", options->sequence_evidence_min_score,
+                  "Filter: the detection score D a keyframe needs for its evidence to count")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  cmd->add_option("--sequence-evidence-min-relative", options->sequence_evidence_min_relative,
+                  "Filter: the keyframe's own relative similarity z with its detection needed for its evidence to count")
+      ->check(CLI::Range(-1e6, 1e6))
+      ->capture_default_str();
+  cmd->add_option("--sequence-evidence-min-share", options->sequence_evidence_min_share,
+                  "Filter: the share of the new place's keyframes an earlier place needs before it gets evidence")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   cmd->add_option("--max-keypoints", options->max_keypoints, "Keypoints per frame (default: the preset's)")
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--histogram-weight", options->histogram_weight, "Similarity: weight of the histogram part (default: the preset's)");

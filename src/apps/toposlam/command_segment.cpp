@@ -62,6 +62,10 @@ void runSegment(const SegmentOptions& o) {
   std::vector<double> fingerprint_ms, segment_ms;
   std::vector<FrameTiming> timing;
   std::int64_t refused = 0;
+  // The window's clock: the frames' timestamps with any step back cut out (docs/reliability.md, "Clock
+  // jumps"); frames.csv records it. Motion is looked up at the frame's own timestamp (the motion file's
+  // clock is the recording's).
+  FrameTimeline timeline;
   Progress progress("segment", "frames", o.max_frames > 0 && (total <= 0 || total > o.max_frames) ? o.max_frames : total,
                     o.quiet);
   std::int64_t read = 0;
@@ -83,12 +87,14 @@ void runSegment(const SegmentOptions& o) {
     fingerprint_ms.push_back(fingerprint_watch.elapsedMs());
     Stopwatch segment_watch;
     const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
-    const SegmenterStep step = pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint), moving);
+    const SegmenterStep step =
+        pipeline.segment(timeline.place(frame->timestamp_s), frame->name, std::move(fingerprint), moving);
     segment_ms.push_back(segment_watch.elapsedMs());
     timing.push_back(FrameTiming{fingerprint_ms.back(), segment_ms.back(), std::nullopt});
   }
   pipeline.finish();
   progress.finish();
+  if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "segment") << "\n";
   if (motion) std::cerr << motionSummary(*motion, o.motion, "segment") << "\n";
 
   const SegmentationRun& run = pipeline.run();

@@ -162,4 +162,13 @@ FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const
   return config;
 }
 
+std::string timelineSummary(const FrameTimeline& timeline, const std::string& command) {
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "%s: the source's clock went back %lld time(s) (the last by %.3f s); each such frame was placed one "
+                "frame interval after the one before and the frames after it kept their spacing (frames.csv's time)",
+                command.c_str(), static_cast<long long>(timeline.stepsBack()), timeline.lastStepBackS());
+  return text;
+}
+
 }  // namespace toposlam::cli

@@ -15,6 +15,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "toposlam/config/method_preset.hpp"
+#include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/core/output_file.hpp"
 #include "toposlam/io/frame_source.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
@@ -37,6 +38,10 @@ void writeImageFile(const std::filesystem::path& path, const cv::Mat& image);
 
 /// Creates the run folder; throws std::runtime_error naming it when it cannot.
 void createRunFolder(const std::string& dir);
+
+/// "COMMAND: the source's clock went back N times (the last by X s): ..." for a source whose timestamps
+/// stepped back (docs/reliability.md, "Clock jumps").
+std::string timelineSummary(const FrameTimeline& timeline, const std::string& command);
 
 /// One row of timing.csv, milliseconds.
 struct FrameTiming {

@@ -92,7 +92,7 @@ struct Assembly {
     fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get());
     similarity = std::make_unique<NgramSimilarity>(config.similarity);
     segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity, 600,
-                                                               config.segmentation_motion);
+                                                               config.segmentation_motion, config.sequence_evidence);
     topology = std::make_unique<ParticleFilterTopologyStage>(config.topology, *similarity, clock,
                                                              config.topology_slice_items, config.topology_alternatives);
   }
