@@ -323,10 +323,11 @@ const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopolog
 const WireSchema kMotion = {fixed(8 * 7 + 1)};
 
 template <typename Message>
-bool decodeMessage(const lcm::ReceiveBuffer* buffer, Message& msg, const std::string& kind) {
-  if (!lcmArrayLengthsFit(kind, buffer->data, buffer->data_size)) return false;
+bool decodeMessage(const void* data, std::size_t size, Message& msg, const std::string& kind) {
+  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max()) || !lcmArrayLengthsFit(kind, data, size))
+    return false;
   try {
-    return msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) >= 0;
+    return msg.decode(data, 0, static_cast<int>(size)) >= 0;
   } catch (const std::exception&) {  // bad_alloc, length_error: survived and counted as malformed
     return false;
   }
@@ -355,13 +356,8 @@ LcmSubscriber::LcmSubscriber(const std::string& url, const LcmChannels& known, c
                              Callback callback)
     : lcm_(openLcm(url)), callback_(std::move(callback)) {
   for (const std::string& channel : channels) {
-    std::string kind;
-    if (channel == known.place) kind = "place";
-    else if (channel == known.place_event) kind = "place_event";
-    else if (channel == known.topology) kind = "topology";
-    else if (channel == known.status) kind = "status";
-    else if (channel == known.motion) kind = "motion";
-    else
+    const std::string kind = channelKind(known, channel);
+    if (kind.empty())
       throw std::invalid_argument("unknown channel '" + channel + "': expected one of " + known.place + ", " +
                                   known.place_event + ", " + known.topology + ", " + known.status + ", " + known.motion);
     routes_.push_back(std::make_unique<Route>(Route{this, kind}));
@@ -382,15 +378,35 @@ bool LcmSubscriber::handle(int timeout_ms) {
 void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string& channel, Route* route) {
   LcmSubscriber& self = *route->self;
   ReceivedMessage out;
+  if (!decodeLcmMessage(route->kind, channel, buffer->data, buffer->data_size, out)) {
+    self.malformed_.fetch_add(1);
+    return;
+  }
+  self.received_.fetch_add(1);
+  if (self.callback_) self.callback_(out);
+}
+
+std::string channelKind(const LcmChannels& known, const std::string& channel) {
+  if (channel == known.place) return "place";
+  if (channel == known.place_event) return "place_event";
+  if (channel == known.topology) return "topology";
+  if (channel == known.status) return "status";
+  if (channel == known.motion) return "motion";
+  return "";
+}
+
+bool decodeLcmMessage(const std::string& kind, const std::string& channel, const void* data, std::size_t size,
+                      ReceivedMessage& out) {
+  out = ReceivedMessage{};
   out.channel = channel;
-  out.kind = route->kind;
+  out.kind = kind;
   std::ostringstream json;
   JsonWriter w(json, false);
-  w.beginObject().field("channel", channel).field("kind", route->kind);
+  w.beginObject().field("channel", channel).field("kind", kind);
   bool ok = true;
-  if (route->kind == "place") {
+  if (kind == "place") {
     toposlam_lcm::place_t m{};
-    ok = decodeMessage(buffer, m, route->kind);
+    ok = decodeMessage(data, size, m, kind);
     if (ok) {
       out.frame = m.frame;
       out.node = m.node;
@@ -415,9 +431,9 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
                     m.is_new ? " new" : "", static_cast<long long>(m.map_revision), static_cast<double>(m.latency_ms));
       out.summary = line;
     }
-  } else if (route->kind == "place_event") {
+  } else if (kind == "place_event") {
     toposlam_lcm::place_event_t m{};
-    ok = decodeMessage(buffer, m, route->kind);
+    ok = decodeMessage(data, size, m, kind);
     if (ok) {
       out.node = m.node;
       out.place = m.place;
@@ -435,9 +451,9 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
                     static_cast<long long>(m.representative_frame), m.jpeg_size);
       out.summary = line;
     }
-  } else if (route->kind == "topology") {
+  } else if (kind == "topology") {
     toposlam_lcm::topology_t m{};
-    ok = decodeMessage(buffer, m, route->kind);
+    ok = decodeMessage(data, size, m, kind);
     if (ok) {
       out.node = m.current_node;
       w.field("map_revision", m.map_revision).field("probability", m.probability).field("particles", m.particles)
@@ -456,9 +472,9 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
                     static_cast<long long>(m.map_revision), m.num_nodes, m.num_edges, m.probability, m.current_node);
       out.summary = line;
     }
-  } else if (route->kind == "status") {
+  } else if (kind == "status") {
     toposlam_lcm::status_t m{};
-    ok = decodeMessage(buffer, m, route->kind);
+    ok = decodeMessage(data, size, m, kind);
     if (ok) {
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);
@@ -498,7 +514,7 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
     }
   } else {
     toposlam_lcm::motion_t m{};
-    ok = decodeMessage(buffer, m, route->kind);
+    ok = decodeMessage(data, size, m, kind);
     if (ok) {
       w.field("utime", m.utime).field("sequence", m.sequence).field("forward_m", m.forward_m)
           .field("turn_rad", m.turn_rad).field("moving", m.moving != 0);
@@ -512,14 +528,10 @@ void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string
       out.motion_turn_rate_rps = std::abs(m.angular_velocity_rps);
     }
   }
-  if (!ok) {
-    self.malformed_.fetch_add(1);
-    return;
-  }
+  if (!ok) return false;
   w.endObject();
   out.json = json.str();
-  self.received_.fetch_add(1);
-  if (self.callback_) self.callback_(out);
+  return true;
 }
 
 }  // namespace toposlam

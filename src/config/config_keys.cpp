@@ -194,6 +194,18 @@ std::vector<ConfigKey> makeKeys() {
                    "no route to the multicast group yet (network not up): try again every this many seconds, "
                    "status \"waiting for the network\"")
                   .withNote("0 = exit 1 at once"));
+  // Recording (RecordSettings; docs/deploy.md section 5).
+  k.push_back(text("record.dir", AT(record.dir), "", 0, 4096,
+                   "record the frames processed into a new subfolder (its UTC start time) of this folder, for "
+                   "images:DIR/<subfolder>?rate=recorded. Relative paths resolve like map.path. \"\" = no recording")
+                  .withOption("--record"));
+  k.push_back(real("record.max_mb", AT(record.max_mb), 1024, 1, 1e7, "MB",
+                   "bound on all recordings under record.dir together; recording stops there, mapping goes on"));
+  k.push_back(choice("record.format", AT(record.format), std::string("jpg"), std::vector<std::string>{"jpg", "png"},
+                     "jpg, or png (lossless, about 5x larger)"));
+  k.push_back(integer("record.jpeg_quality", AT(record.jpeg_quality), 90, 1, 100, "", "JPEG quality of the recording"));
+  k.push_back(integer("record.queue_frames", AT(record.queue_frames), 16, 1, 1024, "frames",
+                      "frames waiting for the writer before the oldest is dropped (counted)"));
   // Map.
   k.push_back(text("map.path", AT(pipeline.map_path), "map.tsm", 0, 4096,
                    "the map file (MapStore format, docs/topology.md). Relative paths resolve against "
@@ -570,6 +582,7 @@ const std::vector<ConfigSection>& daemonConfigSections() {
   static const std::vector<ConfigSection> sections = {
       {"lcm", "LCM transport and channel names"},
       {"lcm.channels", "channel names, 1 .. 255 characters each"},
+      {"record", "the frames toposlamd processes, recorded for replay (docs/deploy.md)"},
       {"map", "the map file: where, when it is saved, whether it is resumed"},
       {"watchdog", "systemd watchdog"},
       {"pipeline", "queues, threads and time budgets of the daemon's pipeline (docs/daemon.md)"},

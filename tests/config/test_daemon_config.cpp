@@ -49,6 +49,7 @@ SCENARIO("The shipped config documents the defaults in code") {
 SCENARIO("Values given in the file override the defaults") {
   const DaemonConfig c = parseDaemonConfig(R"(
 source: "images:/data/run1?rate=5"
+record: {dir: /data/recordings, max_mb: 50, format: png, queue_frames: 4}
 lcm: {url: "udpm://239.255.76.67:7667?ttl=1", channels: {place: ROBOT1_PLACE}}
 map: {path: /var/lib/toposlam/office.tsm, save_period_s: 0, load_at_start: false}
 pipeline:
@@ -80,6 +81,11 @@ topology: {particles: 200, seed: 42}
   CHECK(c.segmentation.cut_placement == CutPlacement::ValleyFrame);
   CHECK(c.topology.particles == 200);
   CHECK(c.topology.seed == 42u);
+  CHECK(c.record.dir == "/data/recordings");
+  CHECK(c.record.max_mb == 50.0);
+  CHECK(c.record.format == "png");
+  CHECK(c.record.queue_frames == 4);
+  CHECK(c.record.jpeg_quality == 90);
 }
 
 SCENARIO("Bad configs are refused with the key's full name and the allowed range") {
@@ -91,6 +97,11 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"pipeline: {threads: {gpu: {}}}", "unknown key 'pipeline.threads.gpu'"},
       {"pipeline: {queues: {frames: 0}}", "pipeline.queues.frames: 0 is out of range, allowed 1 .. 1024"},
       {"pipeline: {queues: {results: 5000}}", "pipeline.queues.results: 5000 is out of range, allowed 1 .. 1024"},
+      {"record: {max_mb: 0}", "record.max_mb: 0 is out of range, allowed [1, 1e+07] MB"},
+      {"record: {format: bmp}", "record.format: 'bmp' is not allowed, expected one of: jpg, png"},
+      {"record: {jpeg_quality: 0}", "record.jpeg_quality: 0 is out of range, allowed 1 .. 100"},
+      {"record: {queue_frames: 2000}", "record.queue_frames: 2000 is out of range, allowed 1 .. 1024 frames"},
+      {"record: {directory: /tmp}", "unknown key 'record.directory'"},
       {"lcm: {open_retry_s: -1}", "lcm.open_retry_s: -1 is out of range, allowed [0, 3600] seconds (0 = exit 1 at once)"},
       {"log_level: verbose", "log_level: 'verbose' is not allowed, expected one of: trace, debug, info, warn, error"},
       {"pipeline: {queues: {overflow: drop_newest}}", "pipeline.queues.overflow: 'drop_newest' is not allowed, expected one of: drop_oldest, block"},

@@ -5,14 +5,15 @@
 # shipped config's lcm.url (which must be the examples' default). Meanwhile subscriber_check.py reads every
 # channel with toposlam_lcm.udpm_reader and checks what it decoded (place_t per frame, place events with
 # their JPEG, topology_t, the final status), and lcm-logplayer publishes one ~300 kB message, which liblcm
-# sends in several LC03 fragments, to check the reader's reassembly against LCM's own sender.
+# sends in several LC03 fragments, to check the reader's reassembly against LCM's own sender. lcm-logger
+# records the run meanwhile; `toposlam listen --from lcmlog:` reads the log back (issue 16).
 # Run by in_netns.sh; exit 77 (skipped) outside a network namespace or without multicast.
-# Usage: check_listen_places.sh PYTHON3 TOPOSLAMD CPP_EXAMPLE SOURCE_DIR PYTHONPATH
+# Usage: check_listen_places.sh PYTHON3 TOPOSLAMD CPP_EXAMPLE SOURCE_DIR PYTHONPATH TOPOSLAM
 set -eu
-python3="$1" toposlamd="$2" cpp_example="$3" src="$4"
+python3="$1" toposlamd="$2" cpp_example="$3" src="$4" toposlam="$6"
 export PYTHONPATH="$5" PYTHONDONTWRITEBYTECODE=1
 [ -n "${TOPOSLAM_IN_NETNS:-}" ] || { echo "SKIP: no network namespace here (unshare -rn failed)"; exit 77; }
-command -v lcm-logplayer >/dev/null || { echo "SKIP: lcm-logplayer is not installed (liblcm-bin)"; exit 77; }
+command -v lcm-logplayer >/dev/null && command -v lcm-logger >/dev/null || { echo "SKIP: lcm-logplayer or lcm-logger is not installed (liblcm-bin)"; exit 77; }
 check="$src/tests/e2e/subscriber_check.py"
 tmp="$(mktemp -d)"
 pids=""
@@ -48,6 +49,11 @@ while [ ! -s "$tmp/ready" ]; do
   sleep 0.1
 done
 
+# lcm-logger records toposlamd's channels (its own subscription; given a moment to join the group).
+lcm-logger --lcm-url="$url" --channel='TOPOSLAM_.*' --force --quiet "$tmp/robot.lcmlog" >"$tmp/logger.log" 2>&1 &
+logger=$!
+pids="$pids $logger"
+sleep 0.5
 # One large message through liblcm, then the daemon's whole run.
 "$python3" "$check" large-log "$tmp/large.lcmlog"
 lcm-logplayer -l "$url" "$tmp/large.lcmlog" >"$tmp/logplayer.log" 2>&1 || { cat "$tmp/logplayer.log"; fail "lcm-logplayer"; }
@@ -56,6 +62,16 @@ status=0
   --overflow block >"$tmp/toposlamd.log" 2>&1 || status=$?
 [ $status -eq 0 ] || { tail -20 "$tmp/toposlamd.log"; fail "toposlamd exited with $status"; }
 echo "toposlamd ran $(($(date +%s) - start)) s after the start of the test: $(tail -1 "$tmp/toposlamd.log")"
+sleep 0.3  # lcm-logger flushes every 100 ms
+kill -INT "$logger"
+wait "$logger" || true
+"$toposlam" listen --from "lcmlog:$tmp/robot.lcmlog" --channels place,place_event >"$tmp/replay.txt" 2>&1 \
+  || { tail -3 "$tmp/replay.txt"; fail "listen --from the lcm-logger log"; }
+estimates=$(grep -c '^place  frame' "$tmp/replay.txt" || true)
+events=$(grep -c '^EVENT  place' "$tmp/replay.txt" || true)
+[ "$estimates" -ge 1537 ] && [ "$events" -ge 20 ] || fail "lcm-logger's log replays $estimates place estimates and $events events"
+"$toposlam" report "lcmlog:$tmp/robot.lcmlog" >"$tmp/report.log" 2>&1 || { cat "$tmp/report.log"; fail "report lcmlog:"; }
+echo "lcm-logger's log ($(wc -c <"$tmp/robot.lcmlog") bytes) replayed: $estimates place estimates, $events place events; report written"
 
 status=0
 wait "$collect" || status=$?

@@ -38,6 +38,17 @@ struct LcmSettings {
   double open_retry_s = 2.0;
 };
 
+/// record: the frames toposlamd processes, kept for replay (io/recording_frame_source.hpp).
+struct RecordSettings {
+  /// Parent folder of the recordings ("" = no recording); each run records into a new subfolder named by
+  /// its UTC start time. Relative: against $STATE_DIRECTORY (like map.path), else the working directory.
+  std::string dir;
+  double max_mb = 1024;        ///< bound on all recordings under `dir` together, 1 .. 10000000 MB
+  std::string format = "jpg";  ///< jpg or png (lossless, about 5x larger)
+  int jpeg_quality = 90;       ///< 1 .. 100
+  int queue_frames = 16;       ///< frames waiting for the writer before the oldest is dropped, 1 .. 1024
+};
+
 struct DaemonConfig {
   /// Method preset (method_preset.hpp): "default" (measured on real frames) or "thesis"; it sets every
   /// stage's settings before the other keys are read.
@@ -45,6 +56,7 @@ struct DaemonConfig {
   /// Frame source URI (see io/source_factory.hpp): images:PATH, video:FILE, sim:WORLD?..., v4l2:/dev/videoN.
   std::string source = "sim:office?route=loop2";
   LcmSettings lcm;
+  RecordSettings record;
   /// log_level: trace, debug, info, warn or error (toposlamd --log-level overrides it).
   std::string log_level = "info";
   bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists

@@ -29,16 +29,18 @@ struct MatchingBenchOptions {
   std::vector<std::string> backends = {"orb"};
   std::vector<std::string> presets = {"default", "thesis"};
   std::vector<int> budgets;  ///< keypoints per frame to measure; empty: the preset's
+  bool json = false;
 };
 
 void runMatchingBench(const MatchingBenchOptions& o) {
   cv::setNumThreads(1);  // one core: the matcher is single-threaded, keep OpenCV from spreading extraction
+  BenchRows rows("similarity", o.json);
   const cv::Size size(o.width, o.height);
   std::vector<cv::Mat> frames = loadSampleFrames(o.samples, size);
   if (static_cast<int>(frames.size()) > o.frames) frames.resize(static_cast<std::size_t>(o.frames));
-  std::cout << "n-gram similarity, one thread, " << frames.size() << " frames at " << size.width << "x"
+  rows.text() << "n-gram similarity, one thread, " << frames.size() << " frames at " << size.width << "x"
             << size.height << ", all ordered pairs x " << o.repeat << " passes (" << o.samples << ")\n";
-  std::cout << std::left << std::setw(16) << "preset kp" << std::right << std::setw(10) << "pairs" << std::setw(14)
+  rows.text() << std::left << std::setw(16) << "preset kp" << std::right << std::setw(10) << "pairs" << std::setw(14)
             << "keypoints/f" << std::setw(13) << "letters/f" << std::setw(13) << "median us" << std::setw(10)
             << "p99 us" << std::setw(16) << "median sim/s" << std::setw(14) << "worst sim/s" << "\n";
   const std::vector<int> budgets = o.budgets.empty() ? std::vector<int>{-1} : o.budgets;
@@ -80,12 +82,17 @@ void runMatchingBench(const MatchingBenchOptions& o) {
     const TimingSummary s = summarize(call_ms);
     std::sort(pass_rates.begin(), pass_rates.end());
     const std::size_t n = prints.size();
-    std::cout << std::left << std::setw(16) << (preset_name + " " + backend) << std::right << std::setw(10) << pairs << std::fixed
+    rows.row({{"preset", preset_name}, {"keypoints_backend", backend}, {"pairs", static_cast<std::int64_t>(pairs)},
+              {"keypoints_per_frame", keypoints / static_cast<double>(n)}, {"letters_per_frame", letters / static_cast<double>(n)},
+              {"median_us", 1000.0 * s.median_ms}, {"p99_us", 1000.0 * s.p99_ms},
+              {"median_similarities_per_s", pass_rates[pass_rates.size() / 2]},
+              {"worst_similarities_per_s", pass_rates.front()}, {"mean_similarity", checksum / static_cast<double>(pairs)}});
+    rows.text() << std::left << std::setw(16) << (preset_name + " " + backend) << std::right << std::setw(10) << pairs << std::fixed
               << std::setprecision(1) << std::setw(14) << keypoints / static_cast<double>(n) << std::setw(13)
               << letters / static_cast<double>(n) << std::setw(13) << 1000.0 * s.median_ms << std::setw(10)
               << 1000.0 * s.p99_ms << std::setprecision(0) << std::setw(16) << pass_rates[pass_rates.size() / 2]
               << std::setw(14) << pass_rates.front() << "\n";
-    std::cout << "  (mean similarity " << std::setprecision(4) << checksum / static_cast<double>(pairs) << ")\n";
+    rows.text() << "  (mean similarity " << std::setprecision(4) << checksum / static_cast<double>(pairs) << ")\n";
   }
 }
 
@@ -109,6 +116,7 @@ void addBenchMatching(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--max-keypoints", options->budgets, "Keypoint budgets per frame to measure (default: the preset's)")
       ->check(CLI::Range(1, 5000));
+  cmd->add_flag("--json", options->json, "Print the rows as one JSON object (the table goes to stderr)");
   cmd->callback([options] { runMatchingBench(*options); });
 }
 

@@ -27,6 +27,7 @@ struct SegmentationBenchOptions {
   int repeat = 10;
   std::vector<int> windows = {25};
   std::string keypoints = "orb";
+  bool json = false;
 };
 
 /// Similarities read from a table computed beforehand (isolates the segmenter's own cost).
@@ -87,11 +88,12 @@ void runSegmentationBench(const SegmentationBenchOptions& o) {
   for (const auto& p : prints) keypoints += p->keypointCount();
   const NgramSimilarity similarity;
   const PrecomputedSimilarity table(prints, similarity);
-  std::cout << "Segmentation step per frame (FiedlerSegmenter::addFrame), " << prints.size()
+  BenchRows rows("segmentation", o.json);
+  rows.text() << "Segmentation step per frame (FiedlerSegmenter::addFrame), " << prints.size()
             << " fingerprints x " << o.repeat << " passes, 640x480 " << o.keypoints << " (" << std::fixed
             << std::setprecision(1) << keypoints / static_cast<double>(prints.size())
             << " keypoints/frame), one thread, full windows only\n";
-  std::cout << std::left << std::setw(8) << "window" << std::setw(22) << "similarity" << std::right
+  rows.text() << std::left << std::setw(8) << "window" << std::setw(22) << "similarity" << std::right
             << std::setw(12) << "median ms" << std::setw(10) << "p99 ms" << std::setw(10) << "max ms"
             << std::setw(10) << "places"
             << "\n";
@@ -101,7 +103,10 @@ void runSegmentationBench(const SegmentationBenchOptions& o) {
       const TimingSummary s =
           timeSegmenter(prints, variant == 0 ? static_cast<const SimilarityMeasure&>(similarity) : table,
                         window, o.repeat, places);
-      std::cout << std::left << std::setw(8) << window << std::setw(22)
+      rows.row({{"window", std::int64_t{window}},
+                {"similarity", std::string(variant == 0 ? "n-gram" : "precomputed table")}, {"median_ms", s.median_ms},
+                {"p99_ms", s.p99_ms}, {"max_ms", s.max_ms}, {"places", static_cast<std::int64_t>(places)}});
+      rows.text() << std::left << std::setw(8) << window << std::setw(22)
                 << (variant == 0 ? "n-gram (2(n-1) calls)" : "precomputed table") << std::right << std::fixed
                 << std::setprecision(3) << std::setw(12) << s.median_ms << std::setw(10) << s.p99_ms
                 << std::setw(10) << s.max_ms << std::setw(10) << places << "\n";
@@ -121,6 +126,7 @@ void addBenchSegmentation(CLI::App& bench) {
   cmd->add_option("--repeat", options->repeat, "Passes over the frames")->check(CLI::Range(1, 1000));
   cmd->add_option("--window", options->windows, "Window sizes to measure")->capture_default_str();
   cmd->add_option("--keypoints", options->keypoints, "Keypoint backend")->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print the rows as one JSON object (the table goes to stderr)");
   cmd->callback([options] { runSegmentationBench(*options); });
 }
 

@@ -26,11 +26,13 @@ struct BenchSimOptions {
   std::vector<int> widths = {320, 640};
   int people = 0;
   int repeat = 1;
+  bool json = false;
 };
 
 void runBenchSim(const BenchSimOptions& options) {
   cv::setNumThreads(1);
-  std::printf("simulated-world renderer, one thread (cv::getNumThreads() = %d), route %s, %d pass(es)\n",
+  BenchRows rows("sim", options.json);
+  std::fprintf(rows.textFile(), "simulated-world renderer, one thread (cv::getNumThreads() = %d), route %s, %d pass(es)\n",
               cv::getNumThreads(), options.route.c_str(), options.repeat);
   for (const std::string& world : options.worlds) {
     for (const int width : options.widths) {
@@ -61,7 +63,10 @@ void runBenchSim(const BenchSimOptions& options) {
       // Wall-clock rate is the target's measure; the CPU-time rate shows the same on a machine shared with
       // other work (cpu/wall < 1 means the process waited for the core).
       const double cpu_fps = cpu_seconds > 0 ? static_cast<double>(s.samples) / cpu_seconds : 0.0;
-      std::printf(
+      rows.row({{"world", world}, {"width", std::int64_t{config.camera.width}}, {"height", std::int64_t{config.camera.height}},
+                {"frames", static_cast<std::int64_t>(s.samples)}, {"median_ms", s.median_ms}, {"p99_ms", s.p99_ms},
+                {"max_ms", s.max_ms}, {"fps", fps}, {"cpu_fps", cpu_fps}});
+      std::fprintf(rows.textFile(),
           "sim %-7s %4dx%-4d: %5zu frames, median %.3f ms, p99 %.3f ms, max %.3f ms, %.0f frames/s "
           "(%.0f per CPU second, cpu/wall %.2f)%s (checksum %llu)\n",
           world.c_str(), config.camera.width, config.camera.height, s.samples, s.median_ms, s.p99_ms,
@@ -89,6 +94,7 @@ void addBenchSim(CLI::App& bench) {
   cmd->add_option("--repeat", options->repeat, "Passes over the route")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print the rows as one JSON object (the table goes to stderr)");
   cmd->callback([options] { runBenchSim(*options); });
 }
 

@@ -30,6 +30,7 @@ struct TopologyBenchOptions {
   int budget = 250;  ///< work items per slice for the sliced measurement
   std::string samples;
   bool real = true;
+  bool json = false;
 };
 
 /// Synthetic fingerprint: only its tag (image width - 1) matters to the fake similarity.
@@ -58,10 +59,10 @@ class FakeSimilarity : public SimilarityMeasure {
   }
 };
 
-void runFilterBench(const TopologyBenchOptions& o) {
-  std::cout << "TopologyParticleFilter, " << o.particles << " particles, fake similarity; a first traversal "
+void runFilterBench(const TopologyBenchOptions& o, BenchRows& rows) {
+  rows.text() << "TopologyParticleFilter, " << o.particles << " particles, fake similarity; a first traversal "
             << "builds N places, then " << o.steps << " steps of a second traversal are measured\n";
-  std::cout << std::setw(8) << "places" << std::setw(12) << "median ms" << std::setw(10) << "p99 ms"
+  rows.text() << std::setw(8) << "places" << std::setw(12) << "median ms" << std::setw(10) << "p99 ms"
             << std::setw(10) << "max ms" << std::setw(14) << "slice max ms" << std::setw(10) << "states"
             << std::setw(10) << "records" << std::setw(8) << "best p"
             << "\n";
@@ -93,28 +94,33 @@ void runFilterBench(const TopologyBenchOptions& o) {
     const TimingSummary s = summarize(step_ms);
     const TimingSummary sl = summarize(slice_ms);
     const TopologyMemoryStats memory = filter.memoryStats();
-    std::cout << std::setw(8) << places << std::fixed << std::setprecision(3) << std::setw(12) << s.median_ms
+    rows.row({{"part", std::string("filter step")}, {"places", std::int64_t{places}}, {"median_ms", s.median_ms},
+              {"p99_ms", s.p99_ms}, {"max_ms", s.max_ms}, {"slice_max_ms", sl.max_ms},
+              {"states", static_cast<std::int64_t>(memory.distinct_states)},
+              {"records", static_cast<std::int64_t>(memory.history_records)},
+              {"best_probability", filter.estimate(0).best.probability}});
+    rows.text() << std::setw(8) << places << std::fixed << std::setprecision(3) << std::setw(12) << s.median_ms
               << std::setw(10) << s.p99_ms << std::setw(10) << s.max_ms << std::setw(14) << sl.max_ms
               << std::setw(10) << memory.distinct_states << std::setw(10) << memory.history_records
               << std::setw(8) << std::setprecision(2) << filter.estimate(0).best.probability << "\n";
   }
 }
 
-void runRealSimilarityBench(const TopologyBenchOptions& o) {
+void runRealSimilarityBench(const TopologyBenchOptions& o, BenchRows& rows) {
   cv::setNumThreads(1);
   const std::vector<cv::Mat> frames = loadSampleFrames(o.samples, cv::Size(320, 240));
   if (frames.size() < 2) {
-    std::cout << "real similarity: fewer than 2 frames in " << o.samples << ", skipped\n";
+    rows.text() << "real similarity: fewer than 2 frames in " << o.samples << ", skipped\n";
     return;
   }
   VpackExtractor extractor;
   std::vector<Fingerprint> fingerprints;
   for (const cv::Mat& frame : frames) fingerprints.push_back(extractor.extract(frame));
   NgramSimilarity similarity;
-  std::cout << "\nOnce-per-step similarity of one new representative against N stored ones (NgramSimilarity, "
+  rows.text() << "\nOnce-per-step similarity of one new representative against N stored ones (NgramSimilarity, "
             << "VPACK ORB at 320x240 of " << fingerprints.size() << " frames of " << o.samples
             << ", 1 thread)\n";
-  std::cout << std::setw(8) << "places" << std::setw(12) << "median ms" << std::setw(10) << "p99 ms"
+  rows.text() << std::setw(8) << "places" << std::setw(12) << "median ms" << std::setw(10) << "p99 ms"
             << std::setw(14) << "us per pair"
             << "\n";
   for (int places : o.places) {
@@ -131,7 +137,9 @@ void runRealSimilarityBench(const TopologyBenchOptions& o) {
       ms.push_back(watch.elapsedMs());
     }
     const TimingSummary s = summarize(ms);
-    std::cout << std::setw(8) << places << std::fixed << std::setprecision(3) << std::setw(12) << s.median_ms
+    rows.row({{"part", std::string("real similarity")}, {"places", std::int64_t{places}}, {"median_ms", s.median_ms},
+              {"p99_ms", s.p99_ms}, {"us_per_pair", 1000.0 * s.median_ms / places}});
+    rows.text() << std::setw(8) << places << std::fixed << std::setprecision(3) << std::setw(12) << s.median_ms
               << std::setw(10) << s.p99_ms << std::setw(14) << std::setprecision(1)
               << 1000.0 * s.median_ms / places << (sink < 0 ? " " : "") << "\n";
   }
@@ -156,9 +164,11 @@ void addBenchTopology(CLI::App& bench) {
   cmd->add_option("--samples", options->samples, "Frames for the real-similarity part")
       ->capture_default_str();
   cmd->add_flag("!--no-real", options->real, "Skip the real-similarity part");
+  cmd->add_flag("--json", options->json, "Print the rows as one JSON object (the table goes to stderr)");
   cmd->callback([options] {
-    runFilterBench(*options);
-    if (options->real) runRealSimilarityBench(*options);
+    BenchRows rows("topology", options->json);
+    runFilterBench(*options, rows);
+    if (options->real) runRealSimilarityBench(*options, rows);
   });
 }
 

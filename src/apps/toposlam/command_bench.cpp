@@ -24,6 +24,7 @@ struct FingerprintBenchOptions {
   std::vector<std::string> backends = {"orb", "sift"};
   std::vector<int> workers = {1, 2};
   std::vector<std::string> formats = {"bgr"};
+  bool json = false;
 };
 
 /// One camera format's way from the buffer to the fingerprint. "-via-bgr": as before issue 18 (every
@@ -57,10 +58,11 @@ std::vector<std::uint8_t> cameraBuffer(const cv::Mat& bgr, CameraPixelLayout lay
 
 void runFingerprintBench(const FingerprintBenchOptions& o) {
   cv::setNumThreads(1);  // measure our own parallelism, not OpenCV's
-  std::cout << "VPACK extraction, " << o.repeat << " passes over the sample frames (" << o.samples << ")\n";
-  std::cout
+  BenchRows rows("fingerprint", o.json);
+  rows.text() << "VPACK extraction, " << o.repeat << " passes over the sample frames (" << o.samples << ")\n";
+  rows.text()
       << "Times from the camera's buffer (bgr: the decoded image) to the fingerprint, conversion included.\n";
-  std::cout << std::left << std::setw(10) << "size" << std::setw(8) << "kp" << std::setw(14) << "format"
+  rows.text() << std::left << std::setw(10) << "size" << std::setw(8) << "kp" << std::setw(14) << "format"
             << std::setw(9) << "workers" << std::right << std::setw(12) << "median ms" << std::setw(10)
             << "p99 ms" << std::setw(10) << "fps" << std::setw(12) << "keypoints" << std::setw(9) << "edges"
             << "\n";
@@ -101,7 +103,12 @@ void runFingerprintBench(const FingerprintBenchOptions& o) {
             }
           }
           const TimingSummary s = summarize(ms);
-          std::cout << std::left << std::setw(10)
+          rows.row({{"width", std::int64_t{size.width}}, {"height", std::int64_t{size.height}}, {"keypoints_backend", backend},
+                    {"format", path.name}, {"workers", std::int64_t{workers}}, {"median_ms", s.median_ms},
+                    {"p99_ms", s.p99_ms}, {"fps", 1000.0 / s.median_ms},
+                    {"keypoints", keypoints / static_cast<double>(ms.size())},
+                    {"edges", edges / static_cast<double>(ms.size())}});
+          rows.text() << std::left << std::setw(10)
                     << (std::to_string(size.width) + "x" + std::to_string(size.height)) << std::setw(8)
                     << backend << std::setw(14) << path.name << std::setw(9) << workers << std::right
                     << std::fixed << std::setprecision(2) << std::setw(12) << s.median_ms << std::setw(10)
@@ -128,6 +135,7 @@ void addBenchFingerprint(CLI::App& bench) {
          "Camera formats, from the camera's buffer: bgr, yuyv, grey, and yuyv-via-bgr, grey-via-bgr (the "
          "way before issue 18: made BGR, then grey again)")
       ->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print the rows as one JSON object (the table goes to stderr)");
   cmd->callback([options] { runFingerprintBench(*options); });
 }
 

@@ -24,6 +24,8 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "progress.hpp"
+#include "toposlam/core/json_writer.hpp"
 #include "toposlam/io/frame_recorder.hpp"
 #include "toposlam/io/source_factory.hpp"
 #include "toposlam/io/v4l2_frame_source.hpp"
@@ -41,6 +43,7 @@ struct CaptureOptions {
   double timeout_s = 0.0;
   int hold = 0;
   bool quiet = false;
+  bool json = false;   ///< --json: the summary as one JSON object, no per-frame lines
   std::string record;  ///< --record DIR: "" = nothing recorded
   FrameRecorderConfig record_config;
   double record_max_mb = 1024;
@@ -103,8 +106,9 @@ void runCapture(const CaptureOptions& options) {
     request_stop = [raw] { raw->interrupt(); };
     from_camera = false;
   }
-  std::printf("source %s\n", source->describe().c_str());
+  if (!options.json) std::printf("source %s\n", source->describe().c_str());
   std::fflush(stdout);
+  const bool per_frame_lines = !options.quiet && !options.json;
   std::optional<FrameRecorder> recorder;
   if (!options.record.empty()) {
     FrameRecorderConfig config = options.record_config;
@@ -120,9 +124,12 @@ void runCapture(const CaptureOptions& options) {
   std::int64_t seen_reconnects = 0;
   std::vector<double> ages_ms;
   const auto started = std::chrono::steady_clock::now();
+  // The progress line only when the frames' own lines are off (-q, --json).
+  Progress progress("capture", "frames", options.count > 0 ? options.count : -1, per_frame_lines);
   while (options.count <= 0 || frames < options.count) {
     std::optional<Frame> frame = source->next();
     if (!frame) break;
+    progress.update(frames + 1);
     if (frames == 0) first_t = frame->timestamp_s;
     last_t = frame->timestamp_s;
     ++frames;
@@ -131,16 +138,17 @@ void runCapture(const CaptureOptions& options) {
                         frame->timestamp_s)
                : 0.0;
     if (recorder && !recorder->record(*frame)) {
+      progress.clearLine();
       std::fprintf(stderr, "capture: --record-max-mb %.0f reached after %lld frames; stopping\n", options.record_max_mb,
                    static_cast<long long>(recorder->frames()));
       break;
     }
     ages_ms.push_back(age_ms);
     if (const std::int64_t now = reconnects(); now != seen_reconnects) {
-      std::printf("event reconnected reconnects=%lld\n", static_cast<long long>(now));
+      if (!options.json) std::printf("event reconnected reconnects=%lld\n", static_cast<long long>(now));
       seen_reconnects = now;
     }
-    if (!options.quiet) {
+    if (per_frame_lines) {
       std::printf("frame seq=%lld t=%.6f size=%dx%d zero_copy=%d age_ms=%.2f\n",
                   static_cast<long long>(frame->sequence), frame->timestamp_s, frame->image.cols,
                   frame->image.rows, frame->buffer_lease ? 1 : 0, age_ms);
@@ -160,18 +168,39 @@ void runCapture(const CaptureOptions& options) {
                ? 0.0
                : ages_ms[static_cast<std::size_t>(q * static_cast<double>(ages_ms.size() - 1) + 0.5)];
   };
-  std::printf(
-      "summary frames=%d dropped=%lld skipped=%lld reconnects=%lld seconds=%.3f fps=%.2f "
-      "age_ms_median=%.2f age_ms_p99=%.2f\n",
-      frames, static_cast<long long>(dropped()), static_cast<long long>(source->skippedFrames()),
-      static_cast<long long>(reconnects()), wall_s, frames > 1 && span_s > 0 ? (frames - 1) / span_s : 0.0,
-      quantile(0.5), quantile(0.99));
-  std::fflush(stdout);
+  progress.finish();
+  if (recorder) recorder->finish();
+  if (options.json) {
+    JsonWriter json(std::cout);
+    json.beginObject()
+        .field("source", source->describe())
+        .field("frames", frames)
+        .field("dropped", dropped())
+        .field("skipped", source->skippedFrames())
+        .field("reconnects", reconnects())
+        .field("seconds", wall_s)
+        .field("fps", frames > 1 && span_s > 0 ? (frames - 1) / span_s : 0.0)
+        .field("age_ms_median", quantile(0.5))
+        .field("age_ms_p99", quantile(0.99));
+    if (recorder)
+      json.key("recorded").beginObject().field("folder", options.record).field("frames", recorder->frames())
+          .field("bytes", static_cast<std::int64_t>(recorder->bytes())).field("full", recorder->full()).endObject();
+    json.endObject();
+    std::cout << "\n" << std::flush;
+  } else {
+    std::printf(
+        "summary frames=%d dropped=%lld skipped=%lld reconnects=%lld seconds=%.3f fps=%.2f "
+        "age_ms_median=%.2f age_ms_p99=%.2f\n",
+        frames, static_cast<long long>(dropped()), static_cast<long long>(source->skippedFrames()),
+        static_cast<long long>(reconnects()), wall_s, frames > 1 && span_s > 0 ? (frames - 1) / span_s : 0.0,
+        quantile(0.5), quantile(0.99));
+    std::fflush(stdout);
+  }
   if (recorder) {
-    recorder->finish();
-    std::printf("recorded %lld frames (%.1f MB) into %s; play back: images:%s?rate=recorded\n",
-                static_cast<long long>(recorder->frames()), static_cast<double>(recorder->bytes()) / (1024.0 * 1024.0),
-                options.record.c_str(), options.record.c_str());
+    if (!options.json)
+      std::printf("recorded %lld frames (%.1f MB) into %s; play back: images:%s?rate=recorded\n",
+                  static_cast<long long>(recorder->frames()), static_cast<double>(recorder->bytes()) / (1024.0 * 1024.0),
+                  options.record.c_str(), options.record.c_str());
     std::fflush(stdout);
     if (recorder->full()) return;  // the size bound ended the capture, as asked
   }
@@ -211,6 +240,7 @@ void addCaptureCommand(CLI::App& app) {
                    "keep the last N frames alive (a slow consumer of zero-copy buffers)")
       ->check(CLI::Range(0, 64));
   command->add_flag("--quiet,-q", options->quiet, "print the summary only");
+  command->add_flag("--json", options->json, "print the summary as one JSON object (no per-frame lines)");
   command->add_option("--record", options->record,
                       "write the frames and timestamps.csv into this new or empty folder; replay with "
                       "images:DIR?rate=recorded");

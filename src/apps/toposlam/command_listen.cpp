@@ -5,6 +5,11 @@
 // It reads the daemon's config (-c FILE, else the same look-up as toposlamd) for lcm.url and the channel
 // names, so a robot whose config renames the channels needs no extra options. Ctrl-C and SIGTERM end it
 // with exit status 0 (and, with --hz, the per-channel message rates).
+//
+// `--from lcmlog:FILE` replays a recorded LCM log instead (lcm-logger's format, or toposlamd's own with
+// `lcm.url: file://FILE?mode=w`), read with the pure LcmLogReader: the same lines, as fast as read; --hz
+// rates over the log's own time. `--run-folder DIR` also turns it into a run folder for `toposlam report`.
+// A corrupt or truncated log is an error naming the byte offset (after the messages before it).
 #include <pthread.h>
 #include <signal.h>
 
@@ -21,6 +26,9 @@
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/config/daemon_config.hpp"
+#include "lcmlog_run_folder.hpp"
+#include "toposlam/platform/lcm_log.hpp"
+#include "toposlam/platform/lcm_log_run.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
 
 namespace toposlam::cli {
@@ -105,6 +113,8 @@ void addListenCommand(CLI::App& app) {
     double timeout_s = 0.0;
     bool json = false;
     bool hz = false;
+    std::string from;
+    std::string run_folder;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("listen", "print toposlamd's place messages (LCM) as they arrive");
@@ -120,6 +130,12 @@ void addListenCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", options->json, "one JSON object per line");
   cmd->add_flag("--hz", options->hz, "at the end, print each channel's message count and rate (messages per second)");
+  auto* from = cmd->add_option("--from", options->from,
+                               "replay a recorded LCM log instead of listening: lcmlog:FILE (lcm-logger's format)");
+  cmd->add_option("--run-folder", options->run_folder,
+                  "with --from: also write the run as a run folder (frames.csv, places.csv, topology.json, "
+                  "thumbnails) for `toposlam report`")
+      ->needs(from);
   cmd->callback([options] {
     DaemonConfig config;
     const std::string config_path = options->config.empty() ? defaultDaemonConfigPath() : options->config;
@@ -140,6 +156,53 @@ void addListenCommand(CLI::App& app) {
     long long printed = 0;
     std::map<std::string, long long> per_channel;
     for (const std::string& c : channels) per_channel[c] = 0;
+    auto printRates = [&](double seconds) {
+      if (!options->hz) return;
+      for (const auto& [channel, n] : per_channel) {
+        const std::string hz = formatRate(seconds > 0 ? static_cast<double>(n) / seconds : 0.0);
+        if (options->json)
+          std::cout << "{\"rate\":{\"channel\":\"" << JsonWriter::escape(channel) << "\",\"messages\":" << n
+                    << ",\"seconds\":" << formatRate(seconds) << ",\"hz\":" << hz << "}}\n";
+        else
+          std::cout << "rate " << channel << ": " << n << " messages in " << formatRate(seconds) << " s = " << hz
+                    << " Hz\n";
+      }
+      std::cout << std::flush;
+    };
+    if (!options->from.empty()) {
+      if (options->from.rfind("lcmlog:", 0) != 0 || options->from.size() == 7)
+        throw CLI::ValidationError("--from", "'" + options->from + "' is not lcmlog:FILE");
+      const std::string path = options->from.substr(7);
+      // The messages first (each decoded as a live subscriber would), then the run folder if asked.
+      LcmLogReader reader(path);
+      std::int64_t first_utime = 0, last_utime = 0, malformed = 0, events = 0;
+      for (LcmLogEvent event; reader.next(event);) {
+        if (events++ == 0) first_utime = event.utime;
+        last_utime = event.utime;
+        const auto wanted = per_channel.find(event.channel);
+        if (wanted == per_channel.end()) continue;
+        ReceivedMessage m;
+        if (!decodeLcmMessage(channelKind(known, event.channel), event.channel, event.data.data(), event.data.size(), m)) {
+          ++malformed;
+          continue;
+        }
+        ++wanted->second;
+        if (options->count > 0 && printed >= options->count) continue;
+        std::cout << (options->json ? m.json : m.summary) << "\n";
+        ++printed;
+      }
+      std::cout << std::flush;
+      printRates(static_cast<double>(last_utime - first_utime) * 1e-6);
+      if (malformed > 0) std::cerr << "toposlam listen: " << malformed << " messages could not be decoded\n";
+      if (!options->run_folder.empty()) {
+        const LoggedRun run = readLoggedRun(path, known);
+        writeRunFolderFromLog(run, path, options->run_folder);
+        std::cerr << "listen: wrote the run folder " << options->run_folder << " (" << run.frames.size()
+                  << " place estimates, " << run.places.size() << " places); toposlam report " << options->run_folder
+                  << "\n";
+      }
+      return;
+    }
     blockStopSignals();  // until the handlers are in place: a signal now waits for them
     LcmSubscriber subscriber(url, known, channels, [&](const ReceivedMessage& m) {
       ++per_channel[m.channel];
@@ -154,19 +217,7 @@ void addListenCommand(CLI::App& app) {
       if (options->timeout_s > 0 && elapsed >= options->timeout_s) break;
       if (!subscriber.handle(100)) throw std::runtime_error("LCM receive failed on " + url);
     }
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (options->hz) {
-      for (const auto& [channel, n] : per_channel) {
-        const std::string hz = formatRate(elapsed > 0 ? static_cast<double>(n) / elapsed : 0.0);
-        if (options->json)
-          std::cout << "{\"rate\":{\"channel\":\"" << JsonWriter::escape(channel) << "\",\"messages\":" << n
-                    << ",\"seconds\":" << formatRate(elapsed) << ",\"hz\":" << hz << "}}\n";
-        else
-          std::cout << "rate " << channel << ": " << n << " messages in " << formatRate(elapsed) << " s = " << hz
-                    << " Hz\n";
-      }
-      std::cout << std::flush;
-    }
+    printRates(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (subscriber.malformed() > 0)
       std::cerr << "toposlam listen: " << subscriber.malformed() << " messages could not be decoded\n";
     if (printed == 0 && options->timeout_s > 0 && g_interrupted == 0) {

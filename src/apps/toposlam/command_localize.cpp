@@ -23,6 +23,7 @@
 #include "commands.hpp"
 #include "toposlam/core/output_file.hpp"
 #include "image_input.hpp"
+#include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/labelled_image_list.hpp"
@@ -63,21 +64,6 @@ struct ThresholdRow {
   double precision() const { return reached > 0 ? static_cast<double>(correct) / reached : 0.0; }
 };
 
-/// Progress on stderr for long runs: about every 10 % when there are at least 20 items.
-class Progress {
- public:
-  Progress(std::string what, std::size_t total) : what_(std::move(what)), total_(total) {}
-  void step(std::size_t done) const {
-    if (total_ < 20) return;
-    const std::size_t every = (total_ + 9) / 10;
-    if (done % every == 0 || done == total_)
-      std::cerr << "toposlam localize: " << what_ << " " << done << "/" << total_ << "\n";
-  }
-
- private:
-  std::string what_;
-  std::size_t total_;
-};
 
 /// Fingerprints one CSV entry; nullopt (and a "file:line: ..." message on stderr) when it is unusable.
 std::optional<Fingerprint> fingerprintEntry(const VpackExtractor& extractor, const LabelledImage& entry,
@@ -121,7 +107,7 @@ void runLocalize(const LocalizeOptions& o) {
   // Places in order of their label's first appearance; several images with one label are its references.
   std::vector<LabelledPlace> places;
   std::map<std::string, std::size_t> place_index;
-  const Progress place_progress("place images", place_list.images.size());
+  Progress place_progress("localize", "place images", static_cast<std::int64_t>(place_list.images.size()));
   for (std::size_t i = 0; i < place_list.images.size(); ++i) {
     const LabelledImage& entry = place_list.images[i];
     if (std::optional<Fingerprint> f = fingerprintEntry(extractor, entry, problems)) {
@@ -129,8 +115,9 @@ void runLocalize(const LocalizeOptions& o) {
       if (inserted) places.push_back({entry.label, {}});
       places[it->second].references.push_back(std::move(*f));
     }
-    place_progress.step(i + 1);
+    place_progress.update(static_cast<std::int64_t>(i + 1));
   }
+  place_progress.finish();
   if (places.empty())
     throw std::runtime_error(o.places + ": no usable place image (" + std::to_string(problems) +
                              " problems reported above)");
@@ -145,7 +132,7 @@ void runLocalize(const LocalizeOptions& o) {
 
   std::vector<Prediction> predictions;
   int unknown_labels = 0;
-  const Progress query_progress("queries", query_list.images.size());
+  Progress query_progress("localize", "queries", static_cast<std::int64_t>(query_list.images.size()));
   for (std::size_t i = 0; i < query_list.images.size(); ++i) {
     const LabelledImage& entry = query_list.images[i];
     if (std::optional<Fingerprint> f = fingerprintEntry(extractor, entry, problems)) {
@@ -161,8 +148,9 @@ void runLocalize(const LocalizeOptions& o) {
       if (place_index.count(entry.label) == 0) ++unknown_labels;
       predictions.push_back(std::move(p));
     }
-    query_progress.step(i + 1);
+    query_progress.update(static_cast<std::int64_t>(i + 1));
   }
+  query_progress.finish();
   if (predictions.empty())
     throw std::runtime_error(o.queries + ": no usable query image (" + std::to_string(problems) +
                              " problems reported above)");

@@ -43,6 +43,7 @@
 #include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 #include "motion_input.hpp"
+#include "progress.hpp"
 
 namespace toposlam::cli {
 
@@ -63,6 +64,7 @@ struct MapOptions {
   SegmentationOptions segmentation;
   MotionOptions motion;
   std::string frame_loops = "sequence";  ///< frame-level loop closures: sequence (default) or visits
+  bool json = false;                     ///< --json: the summary as one JSON object on stdout
   CLI::Option* frame_loops_given = nullptr;
   int loop_min_gap = 10;  ///< visits: detections at least this many frames back
   SequenceLoopConfig sequence_loops;  ///< sequence: keyframes, decay, gap
@@ -222,8 +224,10 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
   std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
 
+  Progress* progress = nullptr;  // the current source's progress line (cleared before a log line)
   auto mapPlace = [&](const SegmentedPlace& place) {
     if (place.dropped) return;
+    if (progress != nullptr) progress->clearLine();
     const auto start = std::chrono::steady_clock::now();
     const MappedPlace mapped = *mapper.mapPlace(place);
     if (!timing.empty()) timing.back().filter_ms = *timing.back().filter_ms + msSince(start);
@@ -242,7 +246,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     // Each traversal's own clock, with any step back inside it cut out (docs/reliability.md, "Clock
     // jumps"); the next source starts its own, so where it goes back a new traversal begins (frames.csv).
     FrameTimeline timeline;
+    Progress source_progress("map", "frames", source->frameCountHint());
+    progress = &source_progress;
+    std::int64_t read = 0;
     while (std::optional<Frame> frame = source->next()) {
+      source_progress.update(++read);
       FrameTiming t;
       t.filter_ms = 0.0;
       auto start = std::chrono::steady_clock::now();
@@ -268,6 +276,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       if (step.closed_place) mapPlace(*step.closed_place);
     }
     if (auto last = mapper.finishTraversal()) mapPlace(*last);
+    source_progress.finish();
+    progress = nullptr;
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
     if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "map") << "\n";
@@ -478,6 +488,21 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     }
   }
 
+  if (o.json) {
+    JsonWriter json(std::cout);
+    json.beginObject()
+        .field("frames", all.frames.size())
+        .field("places", all.places.size())
+        .field("dropped_places", all.dropped_places.size())
+        .field("nodes", nodes.size())
+        .field("best_topology_probability", final_estimate.best.probability)
+        .field("current_node", final_estimate.current_node)
+        .field("current_node_probability", final_estimate.current_node_probability)
+        .field("out", out_dir.string())
+        .endObject();
+    std::cout << "\n" << std::flush;
+    return;
+  }
   std::printf(
       "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "
       "p = %.3f; wrote %s\n",
@@ -497,6 +522,7 @@ void addMapCommand(CLI::App& app) {
                   "processed one after another as consecutive traversals")
       ->required();
   cmd->add_option("--out", options->out, "Output run folder")->required();
+  cmd->add_flag("--json", options->json, "Print the summary as one JSON object (frames, places, nodes, probabilities)");
   auto* particles = cmd->add_option("--particles", options->particles, "Particles (thesis: 500)")
                         ->check(keyRange("topology.particles"))
                         ->capture_default_str();

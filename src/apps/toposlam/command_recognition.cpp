@@ -20,6 +20,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
+#include "progress.hpp"
 #include "image_input.hpp"
 #include "offline_run_io.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -82,12 +83,12 @@ struct FrameSet {
 FrameSet loadFrames(const std::string& uri, const std::string& what, bool quiet, double scale) {
   FrameSet set;
   set.paths = listImageFiles(imagePath(uri));
+  Progress progress("recognition", what + " frames", static_cast<std::int64_t>(set.paths.size()), quiet);
   for (std::size_t k = 0; k < set.paths.size(); ++k) {
+    progress.update(static_cast<std::int64_t>(k + 1));
     cv::Mat image = readImageFile(set.paths[k]);
     if (scale != 1.0) cv::resize(image, image, cv::Size(), scale, scale, scale > 1.0 ? cv::INTER_CUBIC : cv::INTER_AREA);
     set.images.push_back(image);
-    if (!quiet && (k + 1) % 50 == 0)
-      std::cerr << "toposlam recognition: read " << (k + 1) << "/" << set.paths.size() << " " << what << " frames\n";
   }
   return set;
 }

@@ -4,6 +4,9 @@
 // listed in RUN_DIR/source.txt (one source URI per line; `images:DIR` or a plain folder). A frame is
 // found by its frames.csv `name` in its source's folder, or by its position there when that folder holds
 // none of the run's names (see thumbnailPaths).
+//
+// RUN_DIR may be `lcmlog:FILE`, toposlamd's recorded LCM log: it is turned into the run folder FILE.run/
+// first (lcmlog_run_folder.hpp; channel names from toposlamd's config, found as toposlamd finds it).
 #include <algorithm>
 #include <cstdlib>
 #include <ctime>
@@ -23,6 +26,10 @@
 #include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"
+#include "lcmlog_run_folder.hpp"
+#include "toposlam/core/json_writer.hpp"
+#include "toposlam/config/config_path.hpp"
+#include "toposlam/config/daemon_config.hpp"
 
 namespace toposlam::cli {
 
@@ -39,6 +46,7 @@ struct ReportCommandOptions {
   std::string title;
   eval::EvalOptions eval;
   int thumbnails = 96;
+  bool json = false;
 };
 
 std::vector<fs::path> frameFolders(const ReportCommandOptions& o, std::vector<std::string>& warnings) {
@@ -155,7 +163,29 @@ std::string reportTime() {
   return text;
 }
 
-void runReport(const ReportCommandOptions& o) {
+/// `lcmlog:FILE`: converts the log into FILE.run and returns that folder; any other RUN_DIR as it is.
+std::string runFolderOf(const std::string& run_dir) {
+  if (run_dir.rfind("lcmlog:", 0) != 0) return run_dir;
+  const std::string log = run_dir.substr(7);
+  if (log.empty()) throw std::invalid_argument("run_dir: 'lcmlog:' names no file (lcmlog:FILE)");
+  DaemonConfig config;
+  if (const std::string path = defaultDaemonConfigPath(); fs::exists(path)) config = loadDaemonConfig(path);
+  LcmChannels channels;
+  channels.place = config.lcm.place_channel;
+  channels.place_event = config.lcm.place_event_channel;
+  channels.topology = config.lcm.topology_channel;
+  channels.status = config.lcm.status_channel;
+  channels.motion = config.lcm.motion_channel;
+  const LoggedRun run = readLoggedRun(log, channels);
+  const std::string folder = log + ".run";
+  writeRunFolderFromLog(run, log, folder);
+  std::cerr << "converted " << log << " (" << run.events << " events: " << run.frames.size() << " place estimates, "
+            << run.places.size() << " places) into the run folder " << folder << "\n";
+  return folder;
+}
+
+void runReport(ReportCommandOptions o) {
+  o.run_dir = runFolderOf(o.run_dir);
   eval::ReportInputs in;
   in.run = eval::loadRun(o.run_dir);
   in.title = o.title.empty()
@@ -211,6 +241,23 @@ void runReport(const ReportCommandOptions& o) {
     std::cout << "wrote the figures as SVG files into " << o.figures << "\n";
   }
   for (const auto& w : in.warnings) std::cerr << "report: warning: " << w << "\n";
+  if (o.json) {
+    int thumbnails = 0;
+    for (const std::string& t : in.thumbnails) thumbnails += t.empty() ? 0 : 1;
+    JsonWriter json(std::cout);
+    json.beginObject()
+        .field("report", out.string())
+        .field("bytes", static_cast<std::int64_t>(fs::file_size(out)))
+        .field("run", o.run_dir)
+        .field("frames", in.run.frames.size())
+        .field("places", in.run.places.size())
+        .field("thumbnails", thumbnails)
+        .field("evaluated", in.eval.has_value())
+        .field("warnings", in.warnings.size())
+        .endObject();
+    std::cout << "\n" << std::flush;
+    return;
+  }
   std::cout << "wrote " << out.string() << " (" << fs::file_size(out) / 1024 << " KiB)\n";
 }
 
@@ -220,7 +267,9 @@ void addReportCommand(CLI::App& app) {
   auto options = std::make_shared<ReportCommandOptions>();
   auto* cmd = app.add_subcommand("report",
                                  "One self-contained HTML page with the figures and tables of a run folder");
-  cmd->add_option("run_dir", options->run_dir, "Run folder written by `toposlam segment` or `toposlam map`")
+  cmd->add_option("run_dir", options->run_dir,
+                  "Run folder written by `toposlam segment` or `toposlam map`, or lcmlog:FILE (toposlamd's LCM log, "
+                  "converted into FILE.run/)")
       ->required();
   cmd->add_option("--truth", options->truth,
                   "Ground truth as for `toposlam eval` (adds the evaluation tables)");
@@ -233,6 +282,7 @@ void addReportCommand(CLI::App& app) {
   cmd->add_option("--thumbnails", options->thumbnails, "About this many evenly spaced frame thumbnails")
       ->check(CLI::Range(0, 2000))
       ->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print a summary as one JSON object (file, size, frames, places, thumbnails)");
   addEvalMeasureOptions(*cmd, options->eval);
   cmd->callback([options] { runReport(*options); });
 }

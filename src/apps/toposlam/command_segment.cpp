@@ -23,6 +23,8 @@
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
+#include "progress.hpp"
+#include "toposlam/core/json_writer.hpp"
 
 namespace toposlam::cli {
 
@@ -37,6 +39,7 @@ struct SegmentOptions {
   std::int64_t max_frames = 0;
   int workers = 1;
   bool quiet = false;
+  bool json = false;
 };
 
 void runSegment(const SegmentOptions& o) {
@@ -63,17 +66,20 @@ void runSegment(const SegmentOptions& o) {
   // jumps"); frames.csv records it. Motion is looked up at the frame's own timestamp (the motion file's
   // clock is the recording's).
   FrameTimeline timeline;
-  const auto started = std::chrono::steady_clock::now();
-  auto last_report = started;
+  Progress progress("segment", "frames", o.max_frames > 0 && (total <= 0 || total > o.max_frames) ? o.max_frames : total,
+                    o.quiet);
+  std::int64_t read = 0;
   while (o.max_frames <= 0 || static_cast<std::int64_t>(pipeline.run().frames.size()) < o.max_frames) {
     std::optional<Frame> frame = source->next();
     if (!frame) break;
+    progress.update(++read);
     Stopwatch fingerprint_watch;
     std::shared_ptr<const Fingerprint> fingerprint;
     try {
       fingerprint = pipeline.fingerprint(frame->image);
     } catch (const std::invalid_argument& e) {
       // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
+      progress.clearLine();
       if (refused++ == 0)
         std::cerr << "segment: skipping frame '" << frame->name << "': " << e.what() << "\n";
       continue;
@@ -85,19 +91,9 @@ void runSegment(const SegmentOptions& o) {
         pipeline.segment(timeline.place(frame->timestamp_s), frame->name, std::move(fingerprint), moving);
     segment_ms.push_back(segment_watch.elapsedMs());
     timing.push_back(FrameTiming{fingerprint_ms.back(), segment_ms.back(), std::nullopt});
-    const auto now = std::chrono::steady_clock::now();
-    if (!o.quiet && (step.closed_place || now - last_report > std::chrono::seconds(1))) {
-      last_report = now;
-      const double seconds = std::chrono::duration<double>(now - started).count();
-      std::fprintf(stderr, "\rsegment: frame %lld%s%s, %zu places (%zu dropped), %.1f fps   ",
-                   static_cast<long long>(step.frame + 1), total > 0 ? " / " : "",
-                   total > 0 ? std::to_string(total).c_str() : "", pipeline.run().places.size(),
-                   pipeline.run().dropped_places.size(),
-                   static_cast<double>(step.frame + 1) / std::max(seconds, 1e-9));
-    }
   }
   pipeline.finish();
-  if (!o.quiet) std::cerr << "\n";
+  progress.finish();
   if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "segment") << "\n";
   if (motion) std::cerr << motionSummary(*motion, o.motion, "segment") << "\n";
 
@@ -136,6 +132,25 @@ void runSegment(const SegmentOptions& o) {
 
   const TimingSummary f = summarize(fingerprint_ms);
   const TimingSummary s = summarize(segment_ms);
+  if (o.json) {
+    JsonWriter json(std::cout);
+    json.beginObject()
+        .field("frames", run.frames.size())
+        .field("places", run.places.size())
+        .field("dropped_places", run.dropped_places.size())
+        .field("skipped_frames", source->skippedFrames() + refused)
+        .field("window", config.window)
+        .field("gamma", config.valley.gamma)
+        .field("delta", config.valley.delta)
+        .field("fingerprint_ms_median", f.median_ms)
+        .field("fingerprint_ms_p99", f.p99_ms)
+        .field("segment_ms_median", s.median_ms)
+        .field("segment_ms_p99", s.p99_ms)
+        .field("out", o.out)
+        .endObject();
+    std::cout << "\n" << std::flush;
+    return;
+  }
   std::printf(
       "%zu frames -> %zu places kept, %zu dropped (fewer than %d keypoints); window %d, gamma %.3g, "
       "delta %.3g, similarity floor %.3g, %s\n",
@@ -169,6 +184,7 @@ void addSegmentCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
   cmd->add_flag("--quiet", options->quiet, "No progress on stderr");
+  cmd->add_flag("--json", options->json, "Print the summary as one JSON object (frames, places, timings)");
   cmd->callback([options] { runSegment(*options); });
 }
 

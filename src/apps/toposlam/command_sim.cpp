@@ -9,10 +9,13 @@
 #include <iostream>
 #include <memory>
 #include <numbers>
+#include <set>
 #include <stdexcept>
 
 
 #include "commands.hpp"
+#include "progress.hpp"
+#include "toposlam/core/json_writer.hpp"
 #include "offline_run_io.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/sim/floor_plan.hpp"
@@ -37,7 +40,8 @@ struct SimOptions {
   int people = 0;
   double pitch = 0.0;
   bool moved = false;
-  int progress_every = 200;
+  int progress_every = 200;  ///< 0: no progress line (other values: a progress line, see progress.hpp)
+  bool json = false;
 };
 
 sim::SimConfig toConfig(const SimOptions& options) {
@@ -88,7 +92,9 @@ void runSim(const SimOptions& options) {
   const std::int64_t frames = simulator.frameCount();
   std::cerr << "sim: " << frames << " frames of " << config.world << " route " << config.route << " into "
             << out.string() << "\n";
+  Progress progress("sim", "frames", frames, options.progress_every == 0);
   for (std::int64_t i = 0; i < frames; ++i) {
+    progress.update(i + 1);
     const sim::SimFrame frame = simulator.render(i);
     char name[32];
     std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(i));
@@ -117,10 +123,8 @@ void runSim(const SimOptions& options) {
     poses.push_back(frame.truth.pose);
     traversals.push_back(frame.truth.traversal);
     rooms.push_back(frame.truth.room);
-    if (options.progress_every > 0 && (i + 1) % options.progress_every == 0) {
-      std::cerr << "sim: " << (i + 1) << "/" << frames << " frames\n";
-    }
   }
+  progress.finish();
   labels.commit();
   timestamps.commit();
   motion.commit();
@@ -129,6 +133,21 @@ void runSim(const SimOptions& options) {
                  sim::drawWorldMap(simulator.world(), poses, traversals, 40.0, static_cast<int>(config.fps * 5)));
   std::cerr << "sim: wrote " << frames << " frames, labels.csv, motion.csv, loop_closure.png and map.png to " << out.string()
             << "\n";
+  if (options.json) {
+    int rooms_seen = 0;
+    for (int room : std::set<int>(rooms.begin(), rooms.end())) rooms_seen += room >= 0 ? 1 : 0;
+    JsonWriter json(std::cout);
+    json.beginObject()
+        .field("frames", frames)
+        .field("seconds", previous_time_s)
+        .field("traversals", traversals.empty() ? 0 : traversals.back() + 1)
+        .field("rooms", rooms_seen)
+        .field("width", config.camera.width)
+        .field("height", config.camera.height)
+        .field("out", out.string())
+        .endObject();
+    std::cout << "\n" << std::flush;
+  }
 }
 
 }  // namespace
@@ -153,8 +172,9 @@ void addSimCommand(CLI::App& app) {
   cmd->add_option("--pitch", options->pitch, "Camera pitch oscillation amplitude, degrees")->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--moved", options->moved, "Move the furniture between traversals");
-  cmd->add_option("--progress", options->progress_every, "Print a progress line every N frames (0 = never)")
+  cmd->add_option("--progress", options->progress_every, "0: no progress line (on a terminal it shows count, rate and ETA)")
       ->capture_default_str();
+  cmd->add_flag("--json", options->json, "Print a summary as one JSON object (frames, seconds, traversals, rooms)");
   cmd->callback([options] { runSim(*options); });
 }
 

@@ -28,6 +28,7 @@
 
 #include "sources.hpp"
 #include "toposlam/core/worker_pool.hpp"
+#include "toposlam/io/recording_frame_source.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
@@ -139,6 +140,56 @@ bool waitForNetwork(const DaemonConfig& config, const sigset_t& signals, const S
   return true;
 }
 
+/// Wraps the source in a RecordingFrameSource when record.dir is set. Recording is an extra: a folder that
+/// cannot be made, or a bound already reached by earlier recordings, is logged as an error and the daemon
+/// runs without it (the robot keeps mapping). Returns the recorder, or null.
+RecordingFrameSource* startRecording(const RecordSettings& settings, std::unique_ptr<FrameSource>& source) {
+  if (settings.dir.empty()) return nullptr;
+  const std::filesystem::path parent = resolveMapPath(settings.dir);
+  const auto bound = static_cast<std::uint64_t>(settings.max_mb * 1024.0 * 1024.0);
+  const std::uint64_t kept = bytesUnder(parent);
+  if (kept >= bound) {
+    spdlog::error("toposlamd: not recording: {} already holds {:.1f} MB of recordings, record.max_mb is {} MB; remove "
+                  "old recordings (or raise record.max_mb) to record again",
+                  parent.string(), static_cast<double>(kept) / (1024.0 * 1024.0), settings.max_mb);
+    return nullptr;
+  }
+  FrameRecorderConfig recorder_config;
+  recorder_config.format = settings.format;
+  recorder_config.jpeg_quality = settings.jpeg_quality;
+  recorder_config.max_bytes = bound - kept;  // what is left of the bound over all recordings in the folder
+  const std::filesystem::path folder = newRecordingFolder(parent, static_cast<std::int64_t>(std::time(nullptr)));
+  std::unique_ptr<FrameRecorder> recorder;
+  try {
+    recorder = std::make_unique<FrameRecorder>(folder, recorder_config);
+  } catch (const FrameSourceError& e) {
+    spdlog::error("toposlamd: not recording: {} (record.dir {}); running without recording", e.what(), settings.dir);
+    return nullptr;
+  }
+  auto recording = std::make_unique<RecordingFrameSource>(std::move(source), std::move(recorder), settings.queue_frames);
+  RecordingFrameSource* raw = recording.get();
+  source = std::move(recording);
+  spdlog::info("toposlamd: recording the frames into {} ({}, at most {:.1f} MB; replay: images:{}?rate=recorded)",
+               folder.string(), settings.format, static_cast<double>(recorder_config.max_bytes) / (1024.0 * 1024.0),
+               folder.string());
+  return raw;
+}
+
+/// The recording part of the status line: "recording 120 frames (3.1 MB, 0 dropped)", or why it stopped.
+std::string recordingStatus(const RecordingFrameSource& recording) {
+  const RecordingStatus s = recording.status();
+  char text[160];
+  std::snprintf(text, sizeof text, "%lld frames (%.1f MB, %lld dropped)", static_cast<long long>(s.written),
+                static_cast<double>(s.bytes) / (1024.0 * 1024.0), static_cast<long long>(s.dropped));
+  switch (s.state) {
+    case RecordingState::Recording: return std::string("recording ") + text;
+    case RecordingState::Full: return std::string("recording stopped at record.max_mb: ") + text;
+    case RecordingState::Failed: return "recording failed (" + s.problem + "): " + text;
+    case RecordingState::Finished: return std::string("recorded ") + text;
+  }
+  return text;
+}
+
 }  // namespace
 
 std::string resolveMapPath(const std::string& path) {
@@ -164,6 +215,7 @@ int runDaemon(const DaemonConfig& config) {
   pipeline_config.map_path = resolveMapPath(config.pipeline.map_path);
 
   Assembly parts(config, clock, config.source);
+  RecordingFrameSource* recording = startRecording(config.record, parts.source);
   spdlog::info("toposlamd: source {}", parts.source->describe());
 
   // One writer per map: a second daemon (or `toposlam map`) on the same file is refused here, before
@@ -230,10 +282,22 @@ int runDaemon(const DaemonConfig& config) {
   Pipeline pipeline(pipeline_config, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink,
                     clock);
   ThreadTable io_threads;
+  // Whatever ends this function, the I/O threads are told to end before the table joins them.
+  struct EndIoThreads {
+    std::atomic<bool>& receiving;
+    RecordingFrameSource* recording;
+    ~EndIoThreads() {
+      receiving.store(false);
+      if (recording != nullptr) recording->closeWriter();
+    }
+  } end_io_threads{receiving, recording};
   io_threads.start(ThreadSettings{"tsl-lcm-rx"}, [&] {
     while (receiving.load())
       if (!motion.handle(200)) break;
   });
+  // The recording's writer: nice 10, so encoding and writing frames yield to the pipeline's threads.
+  if (recording != nullptr)
+    io_threads.start(ThreadSettings{"tsl-record", -1, SchedulingPolicy::Other, 0, 10}, [recording] { recording->runWriter(); });
   pipeline.start();
   notifier.ready();
   notifier.status("running: " + parts.source->describe());
@@ -265,6 +329,7 @@ int runDaemon(const DaemonConfig& config) {
       if (const auto use = static_cast<MotionUse>(motion_status.use.load()); use != MotionUse::None)
         line += std::string("; motion ") + toString(use) + (use == MotionUse::Lost ? " (segmenting by time)" : "") +
                 ", " + std::to_string(motion_status.standing_frames.load()) + " standing frames skipped";
+      if (recording != nullptr) line += "; " + recordingStatus(*recording);
       notifier.status(stalled.empty() ? line : "stalled: " + stalled + " without progress (watchdog pings withheld); " + line);
     }
   }
@@ -276,7 +341,13 @@ int runDaemon(const DaemonConfig& config) {
   }
   pipeline.wait();
   receiving.store(false);
+  if (recording != nullptr) recording->closeWriter();  // every frame is in: the writer finishes the queue
   io_threads.joinAll();
+  if (recording != nullptr) {
+    const RecordingStatus r = recording->status();
+    spdlog::info("toposlamd: {} into {} ({} frames offered); replay: images:{}?rate=recorded", recordingStatus(*recording),
+                 r.folder, r.offered, r.folder);
+  }
 
   const std::string error = pipeline.error();
   const PipelineStatus last = pipeline.status();

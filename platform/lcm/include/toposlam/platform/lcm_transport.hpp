@@ -96,6 +96,15 @@ struct ReceivedMessage {
 /// message's own size. LcmSubscriber refuses (counts as malformed) a message for which this is false.
 bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size);
 
+/// The kind of `channel` by `known`'s names: place, place_event, topology, status or motion; "" for none.
+std::string channelKind(const LcmChannels& known, const std::string& channel);
+
+/// Decodes one message of `kind` (channelKind) as LcmSubscriber hands it to its callback: fields, one line
+/// of JSON, a summary. False (and `out` unusable) for a malformed message. Needs no LCM instance: a log
+/// replay (lcm_log.hpp) decodes with it too.
+bool decodeLcmMessage(const std::string& kind, const std::string& channel, const void* data, std::size_t size,
+                      ReceivedMessage& out);
+
 class LcmSubscriber {
  public:
   using Callback = std::function<void(const ReceivedMessage&)>;
