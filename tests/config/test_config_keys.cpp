@@ -223,7 +223,7 @@ SCENARIO("GIVEN keys the code had but YAML could not set WHEN written THEN they 
 SCENARIO("GIVEN an unknown key WHEN read THEN the error names its path, line and the known keys beside it") {
   CHECK_THAT(errorOf("source: \"sim:office\"\npipeline:\n  queue: {frames: 2}\n"),
              Catch::Contains("unknown key 'pipeline.queue' (line 3; known keys under 'pipeline': filter_budget_ms, "
-                             "queues, status_period_s, threads, thumbnail_width)"));
+                             "opencv_threads, queues, status_period_s, threads, thumbnail_width)"));
   CHECK_THAT(errorOf("sourse: x\n"), Catch::Contains("unknown key 'sourse' (line 1; known keys: "));
 }
 

@@ -80,11 +80,14 @@ done
 if [ -z "$vivid" ]; then
   fail "vivid: no vivid capture node"
 else
+  # The log exists before the capture starts: the wait below counts its frames, and a missing file would
+  # end the wait at once (grep -c prints nothing), disconnecting the camera after 0 frames.
+  : >vivid.txt
   timeout "$(s 100)" "$toposlam" capture "v4l2:$vivid?size=320x240&format=bgr24" -n 120 --timeout "$(s 90)" \
-    >vivid.txt 2>&1 &
+    >>vivid.txt 2>&1 &
   capture=$!
   i=0
-  while [ $i -lt "$(s 600)" ] && [ "$(grep -c '^frame ' vivid.txt)" -lt 10 ]; do sleep 0.1; i=$((i + 1)); done
+  while [ $i -lt "$(s 600)" ] && [ "$(grep -c '^frame ' vivid.txt 2>/dev/null || true)" -lt 10 ]; do sleep 0.1; i=$((i + 1)); done
   v4l2-ctl -d "$vivid" -c disconnect=1 >/dev/null 2>&1 || echo "  (v4l2-ctl disconnect returned $?)"
   echo "VMTEST vivid disconnected after $(grep -c '^frame ' vivid.txt) frames"
   wait $capture
