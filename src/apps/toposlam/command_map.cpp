@@ -479,9 +479,21 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (std::system("command -v dot >/dev/null 2>&1") == 0) {
       const std::string dot_path = shellQuote((out_dir / "topology.dot").string());
       for (const char* format : {"svg", "png"}) {
-        const std::string command = std::string("dot -T") + format + " " + dot_path + " -o " +
-                                    shellQuote((out_dir / (std::string("topology.") + format)).string());
-        if (std::system(command.c_str()) != 0) std::cerr << "map: warning: `" << command << "` failed\n";
+        // Drawn to a temporary name and renamed only when dot succeeded: a failing dot (a full disk) leaves
+        // the earlier drawing, never a truncated one, under the real name.
+        const fs::path final_path = out_dir / (std::string("topology.") + format);
+        const fs::path temporary = out_dir / (std::string(".topology.") + format + ".tmp");
+        const std::string command =
+            std::string("dot -T") + format + " " + dot_path + " -o " + shellQuote(temporary.string());
+        std::error_code error;
+        if (std::system(command.c_str()) != 0) {
+          std::cerr << "map: warning: `" << command << "` failed; " << final_path.string() << " not written\n";
+          fs::remove(temporary, error);
+        } else if (fs::rename(temporary, final_path, error); error) {
+          std::cerr << "map: warning: cannot rename " << temporary.string() << " to " << final_path.string() << ": "
+                    << error.message() << "\n";
+          fs::remove(temporary, error);
+        }
       }
     } else {
       std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
