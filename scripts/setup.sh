@@ -8,7 +8,7 @@ set -euo pipefail
 # To build (scripts/build.sh builds the test suite too, so Catch2's headers are a build dependency).
 BUILD_PACKAGES=(
   build-essential cmake ninja-build pkg-config ccache
-  libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2
+  libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2 zlib1g-dev
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
   help2man file  # the man pages from --help; `file`: cpack's dpkg-shlibdeps step (scripts/package.sh)
 )

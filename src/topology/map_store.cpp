@@ -17,6 +17,7 @@
 #include <sstream>
 #include <streambuf>
 #include <vector>
+#include <zlib.h>
 
 #include "binary_io.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -142,6 +143,44 @@ std::uint64_t fnv1a64(std::string_view data) {
   return hash;
 }
 
+namespace {
+
+/// The checksum of one map format version, fed piece by piece (a large map is verified streamed).
+class PayloadChecksum {
+ public:
+  explicit PayloadChecksum(std::uint32_t version) : crc_(version >= 3) {}
+  void add(const char* data, std::size_t size) {
+    if (crc_) {
+      // zlib takes at most a uInt per call.
+      while (size > 0) {
+        const auto n = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
+        crc32_ = ::crc32(crc32_, reinterpret_cast<const Bytef*>(data), n);
+        data += n;
+        size -= n;
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < size; ++i) {
+      fnv_ ^= static_cast<std::uint8_t>(data[i]);
+      fnv_ *= 0x100000001b3ULL;
+    }
+  }
+  std::uint64_t value() const { return crc_ ? static_cast<std::uint64_t>(crc32_) : fnv_; }
+
+ private:
+  bool crc_;
+  uLong crc32_ = ::crc32(0L, Z_NULL, 0);
+  std::uint64_t fnv_ = 0xcbf29ce484222325ULL;
+};
+
+}  // namespace
+
+std::uint64_t mapPayloadChecksum(std::uint32_t version, std::string_view payload) {
+  PayloadChecksum checksum(version);
+  checksum.add(payload.data(), payload.size());
+  return checksum.value();
+}
+
 bool settingDiffers(const MapSettings& recorded, const MapSettings& current, const std::string& key) {
   const auto a = recorded.find(key);
   const auto b = current.find(key);
@@ -170,7 +209,7 @@ std::string MapStore::encode(const FrozenTopologyState& frozen, std::string_view
   file.u32(kMapFormatVersion);
   file.u32(0);
   file.u64(payload.data().size());
-  file.u64(fnv1a64(payload.data()));
+  file.u64(mapPayloadChecksum(kMapFormatVersion, payload.data()));
   std::string out = file.take();
   out += payload.data();
   return out;
@@ -199,7 +238,7 @@ std::string_view MapStore::verifiedPayload(std::string_view file, const std::str
   }
   if (payload.size() > size)
     throw MapStoreError(name + ": damaged map file (trailing bytes after the payload)");
-  if (fnv1a64(payload) != checksum) throw MapStoreError(name + ": damaged map file (checksum mismatch)");
+  if (mapPayloadChecksum(version, payload) != checksum) throw MapStoreError(name + ": damaged map file (checksum mismatch)");
   return payload;
 }
 
@@ -244,18 +283,15 @@ bool MapStore::fileVerifies(const std::filesystem::path& path) {
   const std::uint64_t size = fields.u64("size");
   const std::uint64_t checksum = fields.u64("checksum");
   if (version == 0 || version > kMapFormatVersion || file_size - kHeaderSize != size) return false;
-  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  PayloadChecksum hash(version);
   std::vector<char> chunk(1 << 20);
   for (std::uint64_t left = size; left > 0;) {
     const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(left, chunk.size()));
     if (!readFully(fd.fd, chunk.data(), n)) return false;
-    for (std::size_t i = 0; i < n; ++i) {
-      hash ^= static_cast<std::uint8_t>(chunk[i]);
-      hash *= 0x100000001b3ULL;
-    }
+    hash.add(chunk.data(), n);
     left -= n;
   }
-  return hash == checksum;
+  return hash.value() == checksum;
 }
 
 void MapStore::writeAtomically(const std::filesystem::path& path, std::string_view bytes,

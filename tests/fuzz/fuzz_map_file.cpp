@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     putLe(file, toposlam::kMapFormatVersion, 4);
     putLe(file, 0, 4);
     putLe(file, rest.size(), 8);
-    putLe(file, toposlam::fnv1a64(rest), 8);
+    putLe(file, toposlam::mapPayloadChecksum(toposlam::kMapFormatVersion, rest), 8);
     file += rest;
   } else {
     file = std::string(rest);

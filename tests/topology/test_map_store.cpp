@@ -139,7 +139,7 @@ TEST_CASE("GIVEN damaged map files WHEN loaded THEN each is refused with a clear
   SECTION("a truncated header") { refused(bytes.substr(0, 12), "truncated"); }
   SECTION("a newer version") {
     std::string newer = bytes;
-    newer[8] = 3;  // format version, little-endian u32 after the magic
+    newer[8] = static_cast<char>(kMapFormatVersion + 1);  // format version, little-endian u32 after the magic
     refused(newer, "newer toposlam");
   }
   SECTION("not a map at all") {
@@ -154,7 +154,7 @@ TEST_CASE("GIVEN damaged map files WHEN loaded THEN each is refused with a clear
     std::string payload(40, '\x7f');
     std::string framed = bytes.substr(0, 16);
     for (int i = 0; i < 8; ++i) framed.push_back(static_cast<char>((payload.size() >> (8 * i)) & 0xff));
-    const std::uint64_t sum = fnv1a64(payload);
+    const std::uint64_t sum = mapPayloadChecksum(kMapFormatVersion, payload);
     for (int i = 0; i < 8; ++i) framed.push_back(static_cast<char>((sum >> (8 * i)) & 0xff));
     refused(framed + payload, "damaged map file", true);
   }
@@ -474,13 +474,34 @@ TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run T
   CHECK_THAT(MapStore::checkSettings(loaded.settings, fingerprintMapSettings(sift), path.string()),
              Catch::Contains(path.string()) && Catch::Contains("keypoints=orb") && Catch::Contains("keypoints=sift"));
 
+  SECTION("a version-2 map (FNV-1a checksum) still loads; version 3 carries zlib's CRC-32") {
+    const std::string v3 = MapStore::encode(*filter, "data", fingerprintMapSettings(orb));
+    REQUIRE(v3[8] == 3);
+    const std::string payload = v3.substr(32);
+    std::string v2 = v3.substr(0, 8);
+    v2 += std::string("\x02\0\0\0\0\0\0\0", 8);
+    for (int i = 0; i < 8; ++i) v2.push_back(static_cast<char>((payload.size() >> (8 * i)) & 0xff));
+    const std::uint64_t sum = fnv1a64(payload);
+    for (int i = 0; i < 8; ++i) v2.push_back(static_cast<char>((sum >> (8 * i)) & 0xff));
+    v2 += payload;
+    const LoadedMap old = MapStore::decode(v2, sim);
+    CHECK(old.application_data == "data");
+    CHECK(old.settings == fingerprintMapSettings(orb));
+    // The same bytes with a version-3 header but the FNV sum are refused: each version its own checksum.
+    std::string mixed = v2;
+    mixed[8] = 3;
+    CHECK_THROWS_WITH(MapStore::decode(mixed, sim), Catch::Contains("checksum mismatch"));
+    // CRC-32's standard check value.
+    CHECK(mapPayloadChecksum(3, "123456789") == 0xCBF43926u);
+    CHECK(mapPayloadChecksum(2, "123456789") == fnv1a64("123456789"));
+  }
   SECTION("a version-1 map (no settings) still loads and is accepted") {
     // Re-frame the payload without the settings block, as version 1 wrote it.
-    const std::string v2 = MapStore::encode(*filter, "data");
-    std::string payload = v2.substr(32);
+    const std::string v3 = MapStore::encode(*filter, "data");
+    std::string payload = v3.substr(32);
     REQUIRE(payload.substr(payload.size() - 8) == std::string(8, '\0'));  // bytes("") of the empty settings
     payload.resize(payload.size() - 8);
-    std::string v1 = v2.substr(0, 8);
+    std::string v1 = v3.substr(0, 8);
     v1 += std::string("\x01\0\0\0\0\0\0\0", 8);
     for (int i = 0; i < 8; ++i) v1.push_back(static_cast<char>((payload.size() >> (8 * i)) & 0xff));
     const std::uint64_t sum = fnv1a64(payload);

@@ -3,7 +3,9 @@
 // Layout (little-endian):
 //   magic "TSLMAP\r\n" (8 bytes; the CR LF catches text-mode mangling)
 //   u32 format version (kMapFormatVersion)   u32 reserved (0)
-//   u64 payload size                          u64 FNV-1a 64 checksum of the payload
+//   u64 payload size                          u64 checksum of the payload: zlib's CRC-32 from version 3
+//                                             (6.5x faster than FNV-1a 64 here; docs/architecture.md),
+//                                             FNV-1a 64 in versions 1 and 2 (still read)
 //   payload: bytes(filter state, TopologyParticleFilter::saveState) bytes(application data)
 //            bytes(settings)                                   (version 2 on; version 1 has none)
 // where bytes(x) = u64 size + x. The application data is opaque to MapStore (the `map` command keeps
@@ -44,7 +46,7 @@
 
 namespace toposlam {
 
-inline constexpr std::uint32_t kMapFormatVersion = 2;
+inline constexpr std::uint32_t kMapFormatVersion = 3;
 /// Default cap on a map file's size (bytes): a bigger file is refused before it is read. A map of 100
 /// places with 500 particles is about 1 MB.
 inline constexpr std::uint64_t kDefaultMaxMapBytes = 256ull << 20;
@@ -86,6 +88,8 @@ class MapFileOps {
 
 /// FNV-1a, 64 bit.
 std::uint64_t fnv1a64(std::string_view data);
+/// The payload checksum a map file of format `version` carries (CRC-32 from 3, FNV-1a 64 before).
+std::uint64_t mapPayloadChecksum(std::uint32_t version, std::string_view payload);
 
 struct LoadedMap {
   std::unique_ptr<TopologyParticleFilter> filter;
