@@ -63,14 +63,22 @@ echo "== map corridor as one sequence"
 $OLD map images:$C/ref images:$C/query --out before-c 2>&1 | tail -1
 $NEW map images:$C/ref images:$C/query --out after-c 2>&1 | tail -1
 $NEW eval after-c --truth $C/gt.csv --json > after-c.json 2>/dev/null
+$OLD eval before-c --truth $C/gt.csv --json > before-c.json 2>/dev/null
+echo "-- with the filter's sequence evidence on (--sequence-evidence 0.99; off by default, docs/topology.md)"
+$NEW map images:$S/samples --sequence-evidence 0.99 --out evid-s 2>&1 | tail -1
+$NEW eval evid-s --truth $S/samples_GT_pairs.csv --json > evid-s.json 2>/dev/null
+$NEW map images:$C/ref images:$C/query --sequence-evidence 0.99 --out evid-c 2>&1 | tail -1
+$NEW eval evid-c --truth $C/gt.csv --json > evid-c.json 2>/dev/null
 echo "== office two laps"
 $OLD map images:$O/frames --out before-o 2>&1 | tail -1
 $NEW map images:$O/frames --out after-o 2>&1 | tail -1
 $NEW eval before-o --truth $O/labels.csv --json > before-o.json 2>/dev/null
 $NEW eval after-o --truth $O/labels.csv --json > after-o.json 2>/dev/null
+$NEW map images:$O/frames --sequence-evidence 0.99 --out evid-o 2>&1 | tail -1
+$NEW eval evid-o --truth $O/labels.csv --json > evid-o.json 2>/dev/null
 python3 - <<'PY'
 import json
-for n in ('before-s','after-s','before-s5','after-s5','after-c','before-o','after-o'):
+for n in ('before-s','after-s','evid-s','before-s5','after-s5','before-c','after-c','evid-c','before-o','after-o','evid-o'):
     try: d=json.load(open('%s.json'%n))
     except Exception as e: print(n,'no eval',e); continue
     out=[n]
@@ -83,5 +91,7 @@ for n in ('before-s','after-s','before-s5','after-s5','after-c','before-o','afte
         r=d['localisation'][0]; out.append('loc@0.5 %d imgs %.1f%%'%(r['images'],100*r['precision']))
     if 'segmentation' in d: out.append('F1 %.2f'%d['segmentation']['f1'])
     if d.get('best_topology_probability'): out.append('p_last %.2f'%d['best_topology_probability'][-1])
+    r=d.get('place_revisits')
+    if r: out.append('by pose %s'%{k: v for k, v in r.items() if k in ('revisits','closed_right','wrong_closures','missed')})
     print(' | '.join(out))
 PY

@@ -71,7 +71,7 @@ struct DaemonConfig {
   FiedlerSegmenterConfig segmentation;
   MotionGateConfig segmentation_motion;  ///< segmentation.motion: when TOPOSLAM_MOTION says the robot stands
   TopologyFilterConfig topology;
-  SequenceEvidenceConfig sequence_evidence;  ///< from the preset (docs/topology.md); weight 0 in "thesis"
+  SequenceEvidenceConfig sequence_evidence;  ///< topology.sequence_evidence.* (docs/topology.md); off by default
   int topology_slice_items = 256;  ///< topology.slice_items: work items per advance() slice, 1 .. 1000000
   int topology_alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
 

@@ -16,7 +16,6 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
-#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -27,8 +26,6 @@ struct MethodPreset {
   NgramSimilarityConfig similarity;
   FiedlerSegmenterConfig segmentation;
   TopologyFilterConfig topology;
-  /// The filter's second source of evidence, runs of frames (docs/topology.md); off (weight 0) in both.
-  SequenceEvidenceConfig sequence_evidence;
 };
 
 /// "default" or "thesis"; throws std::invalid_argument naming the allowed names otherwise.

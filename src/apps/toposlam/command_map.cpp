@@ -68,7 +68,7 @@ struct MapOptions {
   CLI::Option* frame_loops_given = nullptr;
   int loop_min_gap = 10;  ///< visits: detections at least this many frames back
   SequenceLoopConfig sequence_loops;  ///< sequence: keyframes, decay, gap
-  double sequence_evidence = -1.0;   ///< -1: the preset's weight
+  double sequence_evidence = SequenceEvidenceConfig{}.weight;  ///< 0: off
   double sequence_evidence_min_score = SequenceEvidenceConfig{}.min_score;
   double sequence_evidence_min_relative = SequenceEvidenceConfig{}.min_relative;
   double sequence_evidence_min_share = SequenceEvidenceConfig{}.min_share;
@@ -211,9 +211,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const int first_observation = filter->observationCount();
 
   OfflineMapper mapper(extractor, similarity, segmenter_config, *filter);
-  SequenceEvidenceConfig evidence = preset.sequence_evidence;
+  SequenceEvidenceConfig evidence;
   evidence.loop = sequence_loops;
-  if (o.sequence_evidence >= 0.0) evidence.weight = o.sequence_evidence;
+  evidence.weight = o.sequence_evidence;
   evidence.min_score = o.sequence_evidence_min_score;
   evidence.min_relative = o.sequence_evidence_min_relative;
   evidence.min_share = o.sequence_evidence_min_share;
@@ -567,8 +567,9 @@ void addMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1e6));
   cmd->add_option("--sequence-evidence", options->sequence_evidence,
                   "Filter: likelihood of an earlier place that every keyframe of the new place detects into (the "
-                  "sequence detector's evidence, docs/topology.md; 0.99 turns it on; default: the preset's, off)")
-      ->check(CLI::Range(0.0, 1.0));
+                  "sequence detector's evidence, docs/topology.md; 0 = off, 0.99 = on)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   cmd->add_option("--sequence-evidence-min-score", options->sequence_evidence_min_score,
                   "Filter: the detection score D a keyframe needs for its evidence to count")
       ->check(CLI::Range(0.0, 1e6))
