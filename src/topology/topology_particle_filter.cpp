@@ -295,8 +295,9 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
         }
         if (indexed_step_) fillBackground();
         if (config_.likelihood == LikelihoodModel::Relative) relativeLikelihoods();
-        for (const std::int32_t o : needed_list_)
-          if (idx(o) < evidence_.size()) similarity_of_[idx(o)] = std::max(similarity_of_[idx(o)], evidence_[idx(o)]);
+        if (!evidence_.empty())
+          for (const std::int32_t o : needed_list_)
+            if (idx(o) < evidence_.size()) similarity_of_[idx(o)] = std::max(similarity_of_[idx(o)], evidence_[idx(o)]);
         phase_ = Phase::Aggregate;
         cursor_ = 0;
         break;
