@@ -409,6 +409,13 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(choice("segmentation.cut_placement", AT(segmentation.cut_placement), CutPlacement::WindowSplit,
                      {{"window-split", CutPlacement::WindowSplit}, {"valley-frame", CutPlacement::ValleyFrame}},
                      "where a place ends: the best split of the valley's window, or the valley frame (thesis)"));
+  k.push_back(choice("segmentation.representative", AT(segmentation.representative), RepresentativeChoice::WindowDegree,
+                     {{"window-degree", RepresentativeChoice::WindowDegree},
+                      {"place-medoid", RepresentativeChoice::PlaceMedoid}},
+                     "a place's representative: the window frame of largest degree (thesis), or the sampled "
+                     "frame most like the place's others"));
+  k.push_back(real("segmentation.representative_interval_s", AT(segmentation.representative_interval_s), 0.5, 0, 3600,
+                   "seconds", "place-medoid: the place's frames are sampled at most this often (0 = every frame)"));
   // Topology (TopologyFilterConfig, the stage's slicing beside it).
   k.push_back(integer("topology.particles", AT(topology.particles), 500, 1, 1000000, "",
                       "particles over topologies (thesis: 500)"));

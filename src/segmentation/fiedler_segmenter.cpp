@@ -57,6 +57,22 @@ CutPlacement parseCutPlacement(const std::string& name) {
   throw std::invalid_argument("cut placement '" + name + "' is unknown: use window-split or valley-frame");
 }
 
+const char* toString(RepresentativeChoice choice) {
+  switch (choice) {
+    case RepresentativeChoice::WindowDegree:
+      return "window-degree";
+    case RepresentativeChoice::PlaceMedoid:
+      return "place-medoid";
+  }
+  return "?";
+}
+
+RepresentativeChoice parseRepresentativeChoice(const std::string& name) {
+  if (name == "window-degree") return RepresentativeChoice::WindowDegree;
+  if (name == "place-medoid") return RepresentativeChoice::PlaceMedoid;
+  throw std::invalid_argument("representative '" + name + "' is unknown: use window-degree or place-medoid");
+}
+
 double maxFiedlerValue(int nodes) {
   if (nodes < 2) return 0.0;
   return static_cast<double>(nodes) / static_cast<double>(nodes - 1);
@@ -77,6 +93,7 @@ std::string FiedlerSegmenterConfig::validate() const {
   if (auto p = outside("window_s", window_s, 0, 3600, " s", " (0 = count frames)")) return *p;
   if (auto p = outside("window_m", window_m, 0, 1000, " m", " (0 = off)")) return *p;
   if (auto p = outside("min_frame_spacing_m", min_frame_spacing_m, 0, 100, " m", " (0 = off)")) return *p;
+  if (auto p = outside("representative_interval_s", representative_interval_s, 0, 3600, " s", " (0 = every frame)")) return *p;
   if (auto p = outside("min_frame_spacing_rad", min_frame_spacing_rad, 0, 10, " rad", "")) return *p;
   if (min_window_frames < 3 || min_window_frames > window) {
     return "min_window_frames: " + std::to_string(min_window_frames) + " is outside the allowed range [3, window = " +
@@ -135,6 +152,78 @@ FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const S
   inv_sqrt_degree_ = Eigen::VectorXd::Zero(n);
   laplacian_ = Eigen::MatrixXd::Zero(n, n);
   candidates_.reserve(static_cast<std::size_t>(4 * n));
+  if (config_.representative == RepresentativeChoice::PlaceMedoid) {
+    place_samples_.reserve(FiedlerSegmenterConfig::kMaxPlaceSamples);
+    place_sample_affinity_ = Eigen::MatrixXd::Zero(FiedlerSegmenterConfig::kMaxPlaceSamples,
+                                                   FiedlerSegmenterConfig::kMaxPlaceSamples);
+    sample_interval_s_ = config_.representative_interval_s;
+  }
+}
+
+void FiedlerSegmenter::samplePlaceFrame(int slot) {
+  const auto s = static_cast<std::size_t>(slot);
+  if (!place_samples_.empty()) {
+    const Candidate& last = place_samples_.back();
+    const double since_s = slot_time_[s] - last.time_s;
+    // A clock that goes back (a new traversal) always samples.
+    if (since_s >= 0.0 && (since_s < sample_interval_s_ * (1.0 - 1e-9) || slot_frame_[s] - last.frame < sample_stride_))
+      return;
+  }
+  if (place_samples_.size() == static_cast<std::size_t>(FiedlerSegmenterConfig::kMaxPlaceSamples)) thinPlaceSamples();
+  const auto i = static_cast<Eigen::Index>(place_samples_.size());
+  for (Eigen::Index j = 0; j < i; ++j) {
+    const double value = sanitizeSimilarity(
+        similarity_.symmetricSimilarity(*place_samples_[static_cast<std::size_t>(j)].fingerprint, *slot_fingerprint_[s]));
+    place_sample_affinity_(i, j) = value;
+    place_sample_affinity_(j, i) = value;
+  }
+  place_sample_affinity_(i, i) = 0.0;
+  // `degree` holds the sample's weight: the frames it stands for at the current rate.
+  place_samples_.push_back(Candidate{slot_frame_[s], static_cast<double>(sample_stride_), slot_time_[s],
+                                     slot_fingerprint_[s], slot_fingerprint_[s]->keypointCount()});
+}
+
+void FiedlerSegmenter::thinPlaceSamples() {
+  // Keep samples 0, 2, 4, ...: new index w takes old index 2w. Reading (2a, 2b) never reads a cell
+  // already written in this pass, so the matrix is compacted in place.
+  const auto count = static_cast<Eigen::Index>(place_samples_.size());
+  const Eigen::Index kept = (count + 1) / 2;
+  for (Eigen::Index a = 0; a < kept; ++a) {
+    for (Eigen::Index b = 0; b < kept; ++b) place_sample_affinity_(a, b) = place_sample_affinity_(2 * a, 2 * b);
+    place_samples_[static_cast<std::size_t>(a)] = std::move(place_samples_[static_cast<std::size_t>(2 * a)]);
+    place_samples_[static_cast<std::size_t>(a)].degree *= 2.0;  // it now stands for its dropped neighbour too
+  }
+  place_samples_.resize(static_cast<std::size_t>(kept));
+  sample_interval_s_ *= 2.0;
+  sample_stride_ *= 2;
+}
+
+std::optional<std::pair<int, double>> FiedlerSegmenter::placeMedoid(int count) const {
+  // Each other sample weighs as many frames as it stands for, so a stretch sampled before a thinning
+  // (or after a reset of the rate) counts as much as the same time sampled densely.
+  std::optional<std::pair<int, double>> best;
+  Candidate best_candidate{};
+  for (int i = 0; i < count; ++i) {
+    Candidate candidate = place_samples_[static_cast<std::size_t>(i)];
+    candidate.degree = 0.0;
+    for (int j = 0; j < count; ++j) candidate.degree += place_sample_affinity_(i, j) * place_samples_[static_cast<std::size_t>(j)].degree;
+    if (!best || preferred(candidate, best_candidate)) {
+      best = std::make_pair(i, candidate.degree);
+      best_candidate = std::move(candidate);
+    }
+  }
+  return best;
+}
+
+void FiedlerSegmenter::dropPlaceSamples(int count) {
+  const auto total = static_cast<Eigen::Index>(place_samples_.size());
+  const Eigen::Index left = total - count;
+  for (Eigen::Index a = 0; a < left; ++a) {
+    for (Eigen::Index b = 0; b < left; ++b) place_sample_affinity_(a, b) = place_sample_affinity_(a + count, b + count);
+  }
+  place_samples_.erase(place_samples_.begin(), place_samples_.begin() + count);
+  sample_interval_s_ = config_.representative_interval_s;
+  sample_stride_ = 1;
 }
 
 int FiedlerSegmenter::slotAtPosition(int position) const {
@@ -373,6 +462,7 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
     degree_.setZero();
   }
   rememberBestWindowFrame(place_start_, std::numeric_limits<std::int64_t>::max());
+  if (config_.representative == RepresentativeChoice::PlaceMedoid) samplePlaceFrame(slot);
 
   // The detector sees lambda2 only once the window is full: while it fills, lambda2 of a perfectly
   // connected window falls as k/(k-1) (2, 1.5, 1.33, ...), which would read as a peak.
@@ -426,6 +516,22 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
   for (const Candidate& c : candidates_) {
     if (c.frame < place_start_ || c.frame > last_frame) continue;
     if (best == nullptr || preferred(c, *best)) best = &c;
+  }
+  if (config_.representative == RepresentativeChoice::PlaceMedoid) {
+    // The place's samples are the first ones (older samples went with the places before it).
+    int in_place = 0;
+    while (in_place < static_cast<int>(place_samples_.size()) &&
+           place_samples_[static_cast<std::size_t>(in_place)].frame <= last_frame)
+      ++in_place;
+    if (const auto medoid = placeMedoid(in_place)) {
+      const Candidate& sample = place_samples_[static_cast<std::size_t>(medoid->first)];
+      place.representative_frame = sample.frame;
+      place.representative_degree = medoid->second;
+      place.representative = sample.fingerprint;
+      place.representative_keypoints = sample.keypoints;
+      best = nullptr;  // a place without samples (shorter than the interval) keeps the window's choice
+    }
+    dropPlaceSamples(in_place);
   }
   if (best != nullptr) {
     place.representative_frame = best->frame;

@@ -35,7 +35,13 @@ TEST_CASE("GIVEN a full window WHEN frames keep arriving and places close THEN a
           "[segmentation][allocation]") {
   auto block = [](int f) { return f / 40; };
   toposlam::test::TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
-  toposlam::FiedlerSegmenter segmenter({}, similarity);
+  toposlam::FiedlerSegmenterConfig config;
+  SECTION("the window-degree representative") {}
+  SECTION("the place-medoid representative, its samples thinned") {
+    config.representative = toposlam::RepresentativeChoice::PlaceMedoid;
+    config.representative_interval_s = 0.0;
+  }
+  toposlam::FiedlerSegmenter segmenter(config, similarity);
   std::vector<std::shared_ptr<const toposlam::Fingerprint>> prints;
   for (int f = 0; f < 400; ++f) prints.push_back(toposlam::test::fakeFingerprint(f));
   long closed = 0;

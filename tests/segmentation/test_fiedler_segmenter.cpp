@@ -10,6 +10,9 @@
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 
 using toposlam::CutPlacement;
+using toposlam::parseRepresentativeChoice;
+using toposlam::RepresentativeChoice;
+using toposlam::toString;
 using toposlam::FiedlerSegmenter;
 using toposlam::FiedlerSegmenterConfig;
 using toposlam::SegmentedPlace;
@@ -470,4 +473,76 @@ TEST_CASE("GIVEN a window in seconds WHEN frames arrive THEN it holds the last w
   // 100 fps: the frame bound (50) wins.
   for (int k = 41; k < 200; ++k) segmenter.addFrame(k, 14.0 + 0.01 * (k - 40), fakeFingerprint(k));
   CHECK(segmenter.windowFrames() == 50);
+}
+
+TEST_CASE(
+    "GIVEN blocks whose frames resemble their neighbours most WHEN the representative is the place medoid "
+    "THEN each place is represented by its middle frame",
+    "[segmentation][segmenter][medoid]") {
+  // Inside a block the similarity falls with the distance in frames, so the frame most like the rest is
+  // the middle one (of 30: frames 14 and 15 tie, the earlier wins). The thesis' window degree picks a
+  // frame near the end instead: its window, looking back, lies wholly in the block.
+  const std::vector<int> labels = blockLabels({30, 30, 30});
+  TableSimilarity similarity([&](int a, int b) {
+    if (labels[static_cast<std::size_t>(a)] != labels[static_cast<std::size_t>(b)]) return 0.05;
+    return 0.95 - 0.01 * std::abs(a - b);
+  });
+  FiedlerSegmenterConfig config = thesisConfig();
+  config.representative = RepresentativeChoice::PlaceMedoid;
+  config.representative_interval_s = 0.0;  // every frame
+  FiedlerSegmenter segmenter(config, similarity);
+  const Run run = runStream(segmenter, 90);
+  REQUIRE(run.places.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    INFO("place " << i);
+    CHECK(run.places[i].first_frame == static_cast<std::int64_t>(30 * i));
+    CHECK(run.places[i].last_frame == static_cast<std::int64_t>(30 * i + 29));
+    CHECK(run.places[i].representative_frame == static_cast<std::int64_t>(30 * i + 14));
+    // Sum over the 29 others of 0.95 - 0.01 |a - b|: 29 * 0.95 - 0.01 * (105 + 120).
+    CHECK(run.places[i].representative_degree == Approx(29 * 0.95 - 2.25).margin(1e-9));
+  }
+  AND_WHEN("the same stream goes through the thesis' window degree") {
+    FiedlerSegmenter thesis(thesisConfig(), similarity);
+    const Run window_run = runStream(thesis, 90);
+    REQUIRE(window_run.places.size() == 3);
+    THEN("past the first place (whose window was still filling), its representatives are not the middle frames") {
+      for (std::size_t i = 1; i < 3; ++i) CHECK(window_run.places[i].representative_frame != run.places[i].representative_frame);
+    }
+  }
+}
+
+TEST_CASE(
+    "GIVEN a place longer than the samples kept WHEN the representative is the place medoid THEN the samples are "
+    "thinned evenly and the medoid stays in the middle",
+    "[segmentation][segmenter][medoid]") {
+  const std::vector<int> labels = blockLabels({300, 60});
+  TableSimilarity similarity([&](int a, int b) {
+    if (labels[static_cast<std::size_t>(a)] != labels[static_cast<std::size_t>(b)]) return 0.05;
+    return 0.95 - 0.002 * std::abs(a - b);
+  });
+  FiedlerSegmenterConfig config = thesisConfig();
+  config.representative = RepresentativeChoice::PlaceMedoid;
+  config.representative_interval_s = 0.2;  // = the stream's frame interval: every frame until thinned
+  FiedlerSegmenter segmenter(config, similarity);
+  const Run run = runStream(segmenter, 360);
+  REQUIRE(run.places.size() == 2);
+  CHECK(run.places[0].last_frame == 299);
+  // 300 frames through 64 slots: thinned to every 8th frame (0, 8, ..., 296), whose middle is 144 or 152.
+  CHECK(run.places[0].representative_frame % 8 == 0);
+  CHECK(std::abs(run.places[0].representative_frame - 150) <= 8);
+  THEN("the next place, sampled coarsely until the first one closed and densely after, keeps its medoid in the "
+       "middle (each sample weighs the frames it stands for)") {
+    CHECK(run.places[1].first_frame == 300);
+    CHECK(std::abs(run.places[1].representative_frame - 330) <= 4);
+  }
+}
+
+TEST_CASE("GIVEN representative settings WHEN validated or parsed THEN bad ones are refused by name",
+          "[segmentation][segmenter][medoid]") {
+  FiedlerSegmenterConfig config;
+  config.representative_interval_s = -1.0;
+  CHECK_THAT(config.validate(), Catch::Contains("representative_interval_s"));
+  CHECK(parseRepresentativeChoice("place-medoid") == RepresentativeChoice::PlaceMedoid);
+  CHECK(std::string(toString(RepresentativeChoice::WindowDegree)) == "window-degree");
+  CHECK_THROWS_WITH(parseRepresentativeChoice("middle"), Catch::Contains("window-degree or place-medoid"));
 }

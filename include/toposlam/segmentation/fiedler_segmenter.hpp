@@ -31,7 +31,9 @@
 // representative has fewer than `min_keypoints` keypoints (no member had enough) is reported as
 // dropped. Candidates older than
 // any possible future border all fall in the open place, so only their best is kept: memory stays
-// O(window) except while a valley candidate waits for confirmation.
+// O(window) except while a valley candidate waits for confirmation. RepresentativeChoice::PlaceMedoid
+// instead samples the place's frames (at most kMaxPlaceSamples) and takes the sample most similar to the
+// others, each weighted by the frames it stands for (docs/segmentation.md: measured, not the default).
 //
 // Deterministic; independent of time (timestamps are passed through). Not thread-safe: one instance
 // per stream. After the window is full, addFrame() does not allocate, closing places included
@@ -43,6 +45,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -61,6 +64,15 @@ enum class CutPlacement : std::uint8_t {
 const char* toString(CutPlacement placement);
 /// Parses "window-split" or "valley-frame"; throws std::invalid_argument otherwise.
 CutPlacement parseCutPlacement(const std::string& name);
+
+/// How a closed place's representative is chosen (docs/segmentation.md, "Representatives").
+enum class RepresentativeChoice : std::uint8_t {
+  WindowDegree = 0,  ///< the thesis (section 4.2.3): the remembered window frame with the largest degree
+  PlaceMedoid = 1,   ///< the sampled frame of the place most similar to the place's other samples
+};
+const char* toString(RepresentativeChoice choice);
+/// Parses "window-degree" or "place-medoid"; throws std::invalid_argument otherwise.
+RepresentativeChoice parseRepresentativeChoice(const std::string& name);
 
 struct FiedlerSegmenterConfig {
   /// The sliding window in time, seconds (docs/segmentation.md, "A window in time"): the window holds
@@ -95,6 +107,12 @@ struct FiedlerSegmenterConfig {
   ValleyDetectorConfig valley{0.5, 0.30};
   int min_keypoints = 15;  ///< places whose representative has fewer keypoints are dropped (thesis: 15)
   CutPlacement cut_placement = CutPlacement::WindowSplit;
+  /// The representative rule; both prefer frames with at least min_keypoints keypoints.
+  RepresentativeChoice representative = RepresentativeChoice::WindowDegree;
+  /// PlaceMedoid: the place's frames are sampled at most this often (its first frame always; allowed
+  /// [0, 3600] s, 0 = every frame); at most kMaxPlaceSamples are kept, halving the rate when full.
+  double representative_interval_s = 0.5;
+  static constexpr int kMaxPlaceSamples = 64;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
   std::string validate() const;
 };
@@ -113,7 +131,9 @@ struct SegmentedPlace {
   double first_time_s = 0.0;
   double last_time_s = 0.0;
   std::int64_t representative_frame = 0;
-  double representative_degree = 0.0;  ///< its degree in the window it was remembered from
+  /// WindowDegree: its degree in the window it was remembered from; PlaceMedoid: the sum of its
+  /// similarities with the place's other samples.
+  double representative_degree = 0.0;
   std::shared_ptr<const Fingerprint> representative;
   int representative_keypoints = 0;
   bool dropped = false;            ///< representative had fewer than min_keypoints keypoints
@@ -190,6 +210,15 @@ class FiedlerSegmenter {
   void compactCandidates();
   /// Window position of the first frame of the newer part at the best split; -1 when none qualifies.
   int bestSplitPosition() const;
+  /// PlaceMedoid: samples the frame just added to the window (slot) when the sampling interval allows.
+  void samplePlaceFrame(int slot);
+  /// PlaceMedoid: keeps every other sample and halves the sampling rate (the samples array is full).
+  void thinPlaceSamples();
+  /// PlaceMedoid: the preferred medoid among the first `count` samples (index, weighted similarity sum
+  /// with the others); none when count is 0.
+  std::optional<std::pair<int, double>> placeMedoid(int count) const;
+  /// PlaceMedoid: forgets the first `count` samples (a closed place's).
+  void dropPlaceSamples(int count);
   /// Closes the open place: at the pending border (valley_frame >= 0) or at the newest frame (-1).
   SegmentedPlace closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
                             double next_start_time_s);
@@ -228,6 +257,12 @@ class FiedlerSegmenter {
   double pending_border_time_s_ = 0.0;
   std::int64_t pending_last_frame_ = -1;  ///< last frame of the closing place at that border
   double pending_last_time_s_ = 0.0;
+  // PlaceMedoid: samples of the open place (and of frames after a pending border), in frame order, with
+  // their pairwise similarities in the top-left corner of place_sample_affinity_ (allocated once).
+  std::vector<Candidate> place_samples_;
+  Eigen::MatrixXd place_sample_affinity_;
+  double sample_interval_s_ = 0.0;     ///< the current sampling interval (doubles when thinned)
+  std::int64_t sample_stride_ = 1;     ///< ... and in frames (doubles when thinned)
   std::int64_t kept_places_ = 0;
   std::int64_t dropped_places_ = 0;
   std::int64_t ignored_valleys_ = 0;

@@ -318,6 +318,10 @@ void runMap(const MapOptions& o, bool filter_options_given) {
                       {"segmentation.gamma", real(segmenter_config.valley.gamma)},
                       {"segmentation.delta", real(segmenter_config.valley.delta)},
                       {"segmentation.cut", toString(segmenter_config.cut_placement)},
+                      {"segmentation.representative",
+                       segmenter_config.representative == RepresentativeChoice::PlaceMedoid
+                           ? std::string("place-medoid, sampled every ") + real(segmenter_config.representative_interval_s) + " s"
+                           : std::string("window-degree")},
                       {"topology.particles", std::to_string(topo.particles)},
                       {"topology.likelihood", toString(topo.likelihood)},
                       {"topology.seed", std::to_string(topo.seed)},

@@ -74,7 +74,7 @@ void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::
 }
 
 namespace {
-enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut };
+enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kRepresentative, kRepresentativeInterval };
 }  // namespace
 
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
@@ -82,6 +82,7 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
   const FiedlerSegmenterConfig d = methodPreset("default").segmentation;
   c = d;
   options.cut = toString(d.cut_placement);
+  options.representative = toString(d.representative);
   auto& given = options.given;
   command.add_option("--preset", options.preset, "Method preset: default (measured on real frames) or thesis")
       ->capture_default_str();
@@ -122,6 +123,16 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
                                         "window) or valley-frame")
                          ->capture_default_str(),
                      kCut);
+  given.emplace_back(command.add_option("--representative", options.representative,
+                                        "Segmentation: a place's representative: window-degree (the thesis) or "
+                                        "place-medoid (the sampled frame most like the place's others)")
+                         ->capture_default_str(),
+                     kRepresentative);
+  given.emplace_back(command.add_option("--representative-interval-s", c.representative_interval_s,
+                                        "Segmentation (place-medoid): sample the place's frames at most this often")
+                         ->capture_default_str()
+                         ->check(keyRange("segmentation.representative_interval_s")),
+                     kRepresentativeInterval);
 }
 
 MethodPreset presetOf(const SegmentationOptions& options, const std::string& command) {
@@ -146,6 +157,8 @@ FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const
       case kFloor: config.similarity_floor = o.similarity_floor; break;
       case kMinKeypoints: config.min_keypoints = o.min_keypoints; break;
       case kCut: config.cut_placement = parseCutPlacement(options.cut); break;
+      case kRepresentative: config.representative = parseRepresentativeChoice(options.representative); break;
+      case kRepresentativeInterval: config.representative_interval_s = o.representative_interval_s; break;
     }
   }
   // --window alone asks for a window of that many frames (the time window is for --window-s).

@@ -59,6 +59,7 @@ struct SegmentationOptions {
   std::string preset = "default";
   FiedlerSegmenterConfig config;  ///< bound to the options; only those given are used
   std::string cut;
+  std::string representative;
   std::vector<std::pair<CLI::Option*, int>> given;  ///< option and which key it sets (offline_run_io.cpp)
 };
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options);
