@@ -9,7 +9,7 @@
 #include "toposlam/io/source_factory.hpp"
 #include "toposlam/io/source_uri.hpp"
 #ifdef TOPOSLAM_HAVE_V4L2
-#include "toposlam/io/v4l2_frame_source.hpp"
+#include "v4l2_frame_source.hpp"
 #endif
 #ifdef TOPOSLAM_HAVE_LIBCAMERA
 #include "toposlam/io/libcamera_frame_source.hpp"
