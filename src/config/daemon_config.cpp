@@ -213,7 +213,7 @@ std::string DaemonConfig::validate() const {
       {"fingerprint (VpackConfig)", fingerprint.validate()},
       {"similarity (NgramSimilarityConfig)", similarity.validate()},
       {"segmentation (FiedlerSegmenterConfig)", segmentation.validate()},
-      {"segmentation.motion (MotionGateConfig)", segmentation_motion.validate()},
+      {"segmentation.motion (MotionGateConfig)", segmentation_stage.motion.validate()},
       {"topology (TopologyFilterConfig)", topology.validate()},
   };
   for (const auto& [stage, problem] : stages)
