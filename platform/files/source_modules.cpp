@@ -9,7 +9,7 @@
 #include <mutex>
 #include <vector>
 
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

@@ -8,7 +8,7 @@
 
 #include <cerrno>
 
-#include "toposlam/io/v4l2_device.hpp"
+#include "v4l2_device.hpp"
 
 namespace toposlam {
 namespace {

@@ -1,7 +1,7 @@
 // V4l2FrameSource: V4L2 streaming capture with mmap buffers, format negotiation, BGR conversion or
 // zero-copy hand-off, drop/skip accounting and reconnect-with-backoff after an unplug.
-// See include/toposlam/io/v4l2_frame_source.hpp for the contract and docs/cameras.md for the reasoning.
-#include "toposlam/io/v4l2_frame_source.hpp"
+// See v4l2_frame_source.hpp for the contract and docs/cameras.md for the reasoning.
+#include "v4l2_frame_source.hpp"
 
 #include <linux/videodev2.h>
 #include <poll.h>

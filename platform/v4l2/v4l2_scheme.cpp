@@ -1,6 +1,6 @@
 // Plugs `v4l2:` into the frame-source factory (openFrameSource), so every app opens cameras by URI.
 #include "toposlam/io/source_factory.hpp"
-#include "toposlam/io/v4l2_frame_source.hpp"
+#include "v4l2_frame_source.hpp"
 
 namespace toposlam {
 

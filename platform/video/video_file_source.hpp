@@ -11,7 +11,7 @@
 
 #include <opencv2/videoio.hpp>
 
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

@@ -212,11 +212,11 @@ std::vector<ConfigKey> makeKeys() {
                    "$STATE_DIRECTORY (systemd StateDirectory=toposlam: /var/lib/toposlam), else the working "
                    "directory. \"\" = never saved")
                   .withOption("--map"));
-  k.push_back(flag("map.load_at_start", AT(load_map_at_start), true,
+  k.push_back(flag("map.load_at_start", AT(map.load_at_start), true,
                    "resume from the map if it exists; a damaged file is moved to *.damaged-<UTC time> and "
                    "map.tsm.prev is loaded instead")
                   .withOption("--no-map-load", false));
-  k.push_back(flag("map.resume_other_source", AT(map_resume_other_source), false,
+  k.push_back(flag("map.resume_other_source", AT(map.resume_other_source), false,
                    "a map records its source (v4l2:/dev/video0, sim:office, ...); one made from another source "
                    "is refused (exit 2) unless this is true")
                   .withOption("--resume-other-source", true));
@@ -229,10 +229,10 @@ std::vector<ConfigKey> makeKeys() {
                     if (v == 0.0 || v >= 1.0) return "";
                     return rangeNumber(v) + " is out of range, allowed 0 (only at stop) or [1, 86400] seconds";
                   }));
-  k.push_back(real("map.max_mb", AT(map_max_mb), 256.0, 1, 65536, "MB",
+  k.push_back(real("map.max_mb", AT(map.max_mb), 256.0, 1, 65536, "MB",
                    "a bigger map file is refused unread (the daemon does not start)"));
   // Watchdog.
-  k.push_back(flag("watchdog.enabled", AT(watchdog), true,
+  k.push_back(flag("watchdog.enabled", AT(watchdog.enabled), true,
                    "ping systemd (WatchdogSec= in the unit) while the pipeline is healthy"));
   k.push_back(real("watchdog.heartbeat_timeout_s", AT(pipeline.heartbeat_timeout_s), 5.0, 0.5, 600, "seconds",
                    "a stage thread silent this long stops the pings"));
@@ -265,7 +265,7 @@ std::vector<ConfigKey> makeKeys() {
                       "OpenCV's own pool, set at start (1: each OpenCV call runs on its stage thread; the thread "
                       "table gives out the parallelism, docs/performance.md)"));
   // Fingerprint (VpackConfig, its pool size beside it).
-  k.push_back(integer("fingerprint.workers", AT(fingerprint_workers), 2, 1, 64, "threads",
+  k.push_back(integer("fingerprint.workers", AT(fingerprint_stage.workers), 2, 1, 64, "threads",
                       "WorkerPool threads for the per-subregion work, incl. the fingerprint thread"));
   k.push_back(real("fingerprint.edges.opening_height_fraction", AT(fingerprint.edges.opening_height_fraction), 0.2, 0,
                    1, "", "vertical opening kernel / image height (thesis: 1/5)")
@@ -378,13 +378,13 @@ std::vector<ConfigKey> makeKeys() {
                    "subtracted from every similarity before it enters the affinity matrix (clamped at 0), so "
                    "frames of different places that still match by colour become unlinked")
                   .exclusive(false, true));
-  k.push_back(real("segmentation.motion.standing_speed_mps", AT(segmentation_motion.standing_speed_mps), 0.05, 0, 10,
+  k.push_back(real("segmentation.motion.standing_speed_mps", AT(segmentation_stage.motion.standing_speed_mps), 0.05, 0, 10,
                    "m/s", "slower than this counts as standing"));
-  k.push_back(real("segmentation.motion.standing_turn_rate_rps", AT(segmentation_motion.standing_turn_rate_rps), 0.1,
+  k.push_back(real("segmentation.motion.standing_turn_rate_rps", AT(segmentation_stage.motion.standing_turn_rate_rps), 0.1,
                    0, 100, "rad/s", "... unless turning faster than this"));
-  k.push_back(real("segmentation.motion.standing_after_s", AT(segmentation_motion.standing_after_s), 1.0, 0, 3600,
+  k.push_back(real("segmentation.motion.standing_after_s", AT(segmentation_stage.motion.standing_after_s), 1.0, 0, 3600,
                    "seconds", "standing once slow for this long"));
-  k.push_back(real("segmentation.motion.timeout_s", AT(segmentation_motion.timeout_s), 1.0, 0, 3600, "seconds",
+  k.push_back(real("segmentation.motion.timeout_s", AT(segmentation_stage.motion.timeout_s), 1.0, 0, 3600, "seconds",
                    "motion is known while the newest sample is at most this old")
                   .exclusive(true, false));
   k.push_back(real("segmentation.valley.gamma", AT(segmentation.valley.gamma), 0.5, 0, 2, "",
@@ -476,9 +476,9 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(integer("topology.candidates.background_samples", AT(topology.candidates.background_samples), 300, 0,
                       100000, "representatives",
                       "evenly spread stored representatives also compared exactly, for the others' statistics"));
-  k.push_back(integer("topology.slice_items", AT(topology_slice_items), 256, 1, 1000000, "work items",
+  k.push_back(integer("topology.slice_items", AT(topology_stage.slice_items), 256, 1, 1000000, "work items",
                       "work items per advance() slice (the time budget is checked between slices)"));
-  k.push_back(integer("topology.alternatives", AT(topology_alternatives), 3, 0, 16, "nodes",
+  k.push_back(integer("topology.alternatives", AT(topology_stage.alternatives), 3, 0, 16, "nodes",
                       "other nodes published with each place estimate"));
   return k;
 }

@@ -212,13 +212,9 @@ std::string DaemonConfig::validate() const {
       {"pipeline (PipelineConfig)", pipeline.validate()},
       {"fingerprint (VpackConfig)", fingerprint.validate()},
       {"similarity (NgramSimilarityConfig)", similarity.validate()},
-#ifdef TOPOSLAM_HAVE_SEGMENTATION
       {"segmentation (FiedlerSegmenterConfig)", segmentation.validate()},
-      {"segmentation.motion (MotionGateConfig)", segmentation_motion.validate()},
-#endif
-#ifdef TOPOSLAM_HAVE_TOPOLOGY
+      {"segmentation.motion (MotionGateConfig)", segmentation_stage.motion.validate()},
       {"topology (TopologyFilterConfig)", topology.validate()},
-#endif
   };
   for (const auto& [stage, problem] : stages)
     if (!problem.empty()) return std::string(stage) + ": " + problem;

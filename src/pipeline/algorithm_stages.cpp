@@ -124,11 +124,11 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
 
 ParticleFilterTopologyStage::ParticleFilterTopologyStage(const TopologyFilterConfig& config,
                                                          const SimilarityMeasure& similarity, const Clock& clock,
-                                                         int slice_items, int alternatives)
+                                                         const TopologyStageConfig& stage)
     : similarity_(similarity),
       clock_(clock),
-      slice_items_(static_cast<std::size_t>(std::max(1, slice_items))),
-      alternatives_(std::max(0, alternatives)),
+      slice_items_(static_cast<std::size_t>(std::max(1, stage.slice_items))),
+      alternatives_(std::max(0, stage.alternatives)),
       candidates_(config.candidates),
       filter_(std::make_unique<TopologyParticleFilter>(config, similarity)) {
   topology_.particles = config.particles;

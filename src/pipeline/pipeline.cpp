@@ -1,8 +1,6 @@
 // Pipeline: the five stage threads and the queues between them; see the header for the shape.
 #include "toposlam/pipeline/pipeline.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,24 +11,14 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "toposlam/platform/thread_os.hpp"
+
 namespace toposlam {
 
 namespace {
 
 constexpr std::chrono::milliseconds kPollPeriod{100};  // how often an idle thread wakes to beat
 const char* const kStageNames[] = {"capture", "fingerprint", "segmentation", "topology", "publisher"};
-
-double threadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
-
-double processCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
 
 std::string rangeError(const std::string& key, double value, const char* range) {
   return key + ": " + std::to_string(value) + " is out of range, allowed " + range;

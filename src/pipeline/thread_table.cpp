@@ -1,16 +1,12 @@
 // ThreadTable: named, optionally pinned and prioritised threads created once and joined at stop.
 #include "toposlam/pipeline/thread_table.hpp"
 
-#include <pthread.h>
-#include <sched.h>
-#include <sys/resource.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstring>
 #include <exception>
 
 #include <spdlog/spdlog.h>
+
+#include "toposlam/platform/thread_os.hpp"
 
 namespace toposlam {
 
@@ -30,25 +26,19 @@ std::string ThreadSettings::validate() const {
 std::vector<std::string> applyThreadSettings(const ThreadSettings& settings) {
   std::vector<std::string> problems;
   const std::string name = settings.name.substr(0, 15);
-  if (int rc = pthread_setname_np(pthread_self(), name.c_str()); rc != 0)
+  if (int rc = setCurrentThreadName(name); rc != 0)
     problems.push_back(name + ": cannot set the thread name: " + std::strerror(rc));
   if (settings.cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(static_cast<unsigned>(settings.cpu), &set);
-    if (int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set); rc != 0)
+    if (int rc = pinCurrentThread(settings.cpu); rc != 0)
       problems.push_back(name + ": cannot pin to CPU " + std::to_string(settings.cpu) + ": " + std::strerror(rc));
   }
   if (settings.policy == SchedulingPolicy::Fifo) {
-    sched_param param{};
-    param.sched_priority = settings.priority;
-    if (int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param); rc != 0)
+    if (int rc = setCurrentThreadFifoPriority(settings.priority); rc != 0)
       problems.push_back(name + ": cannot set SCHED_FIFO priority " + std::to_string(settings.priority) + ": " +
                          std::strerror(rc) + " (needs CAP_SYS_NICE or LimitRTPRIO); running with default scheduling");
   } else if (settings.nice != 0) {
-    // On Linux, setpriority(PRIO_PROCESS, tid) sets the nice value of one thread.
-    if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), settings.nice) != 0)
-      problems.push_back(name + ": cannot set nice " + std::to_string(settings.nice) + ": " + std::strerror(errno));
+    if (int rc = setCurrentThreadNice(settings.nice); rc != 0)
+      problems.push_back(name + ": cannot set nice " + std::to_string(settings.nice) + ": " + std::strerror(rc));
   }
   return problems;
 }

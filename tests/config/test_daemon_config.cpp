@@ -66,7 +66,7 @@ topology: {particles: 200, seed: 42}
   CHECK(c.lcm.status_channel == "TOPOSLAM_STATUS");
   CHECK(c.pipeline.map_path == "/var/lib/toposlam/office.tsm");
   CHECK(c.pipeline.map_save_period_s == 0.0);
-  CHECK_FALSE(c.load_map_at_start);
+  CHECK_FALSE(c.map.load_at_start);
   CHECK(c.pipeline.queues.frames == 4);
   CHECK(c.pipeline.queues.overflow == QueueOverflow::Block);
   CHECK(c.pipeline.threads.topology.name == "my-filter");
@@ -74,7 +74,7 @@ topology: {particles: 200, seed: 42}
   CHECK(c.pipeline.threads.topology.policy == SchedulingPolicy::Fifo);
   CHECK(c.pipeline.threads.topology.priority == 20);
   CHECK(c.pipeline.filter_budget_ms == 7.5);
-  CHECK(c.fingerprint_workers == 1);
+  CHECK(c.fingerprint_stage.workers == 1);
   CHECK(c.fingerprint.keypoints.backend == KeypointBackend::Sift);
   CHECK(c.fingerprint.keypoints.max_keypoints == 200);
   CHECK(c.segmentation.window == 31);

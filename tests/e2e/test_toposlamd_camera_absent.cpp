@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "../pipeline/fake_notify_socket.hpp"
+#include "../platform/systemd/fake_notify_socket.hpp"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;

@@ -1,5 +1,5 @@
 // The HTML report's pure parts: base64, thumbnail choice and the page's structure (no browser here; the
-// browser check is tests/report).
+// browser check is tests/apps/check_report_in_browser.sh).
 #include <catch2/catch.hpp>
 
 #include "eval_fixture.hpp"

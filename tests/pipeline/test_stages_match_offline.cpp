@@ -48,7 +48,7 @@ TEST_CASE("GIVEN sequence evidence on WHEN the daemon's stages and the offline m
   // The daemon's stages, the filter step run to its end after every place.
   FiedlerSegmentationStage segmenter(segmentation(), similarity, 600, {}, evidenceOn());
   ManualClock clock;
-  ParticleFilterTopologyStage filter(topology(), similarity, clock, 64, 3);
+  ParticleFilterTopologyStage filter(topology(), similarity, clock, {64, 3});
   std::vector<ClosedPlace> stage_places;
   const auto mapOnline = [&](const ClosedPlace& place) {
     stage_places.push_back(place);

@@ -12,6 +12,7 @@
 
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
@@ -49,6 +50,19 @@ struct RecordSettings {
   int queue_frames = 16;       ///< frames waiting for the writer before the oldest is dropped, 1 .. 1024
 };
 
+/// map.*: what toposlamd does with the map file at start (the Pipeline saves it: PipelineConfig::map_path).
+struct MapConfig {
+  bool load_at_start = true;         ///< map.load_at_start: resume from pipeline.map_path if it exists
+  /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
+  bool resume_other_source = false;
+  double max_mb = 256;               ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
+};
+
+/// watchdog.*: the systemd watchdog (the Pipeline's own heartbeat: PipelineConfig::heartbeat_timeout_s).
+struct WatchdogConfig {
+  bool enabled = true;  ///< watchdog.enabled: ping systemd while the pipeline is healthy
+};
+
 struct DaemonConfig {
   /// Method preset (method_preset.hpp): "default" (measured on real frames) or "thesis"; it sets every
   /// stage's settings before the other keys are read.
@@ -59,21 +73,19 @@ struct DaemonConfig {
   RecordSettings record;
   /// log_level: trace, debug, info, warn or error (toposlamd --log-level overrides it).
   std::string log_level = "info";
-  bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
-  /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
-  bool map_resume_other_source = false;
-  double map_max_mb = 256;        ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
-  bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
-  PipelineConfig pipeline;        ///< queues, threads, budgets; map.path and map.save_period_s land here
-  int fingerprint_workers = 2;    ///< fingerprint.workers: WorkerPool size incl. the fingerprint thread
+  MapConfig map;                  ///< map.load_at_start, map.resume_other_source, map.max_mb
+  WatchdogConfig watchdog;        ///< watchdog.enabled
+  /// Queues, threads, budgets. The Pipeline saves the map and watches its threads itself, so map.path,
+  /// map.save_period_s and watchdog.heartbeat_timeout_s are its members (PipelineConfig).
+  PipelineConfig pipeline;
   VpackConfig fingerprint;
+  FingerprintStageConfig fingerprint_stage;  ///< fingerprint.workers
   NgramSimilarityConfig similarity;
   FiedlerSegmenterConfig segmentation;
-  MotionGateConfig segmentation_motion;  ///< segmentation.motion: when TOPOSLAM_MOTION says the robot stands
+  SegmentationStageConfig segmentation_stage;  ///< segmentation.motion.*
   TopologyFilterConfig topology;
+  TopologyStageConfig topology_stage;          ///< topology.slice_items, topology.alternatives
   SequenceEvidenceConfig sequence_evidence;  ///< topology.sequence_evidence.* (docs/topology.md); off by default
-  int topology_slice_items = 256;  ///< topology.slice_items: work items per advance() slice, 1 .. 1000000
-  int topology_alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
 
   DaemonConfig();
   /// "" or "<full.dotted.key>: <problem, allowed range>": every key's range and cross-key constraint of

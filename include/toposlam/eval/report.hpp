@@ -8,7 +8,7 @@
 //   - processing time per frame (Figures 5.6/5.7);
 //   - the evaluation tables and the loop-closure precision-recall curve.
 // A small inline script writes `images-ok N` or `images-missing K` into #image-check once the page has
-// loaded, for the headless-browser check (tests/report).
+// loaded, for the headless-browser check (tests/apps/check_report_in_browser.sh).
 //
 // Thread-safety: pure functions of their inputs.
 #pragma once

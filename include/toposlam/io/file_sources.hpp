@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/image_file.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

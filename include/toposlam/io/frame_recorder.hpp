@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

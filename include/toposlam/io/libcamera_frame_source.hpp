@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/source_uri.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "toposlam/io/frame_recorder.hpp"
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/pipeline/bounded_queue.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

@@ -10,8 +10,8 @@
 #include <optional>
 #include <string>
 
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/source_uri.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace toposlam {

@@ -26,6 +26,26 @@ namespace toposlam {
 
 class WorkerPool;
 
+// The stage adapters' own settings, beside the algorithm configs they wrap (VpackConfig,
+// FiedlerSegmenterConfig, TopologyFilterConfig). DaemonConfig holds one of each; the key table
+// (config_keys.cpp) gives each member its key, default and range.
+
+/// fingerprint.*: how the fingerprint stage runs VPACK.
+struct FingerprintStageConfig {
+  int workers = 2;  ///< fingerprint.workers: WorkerPool threads incl. the fingerprint thread, 1 .. 64
+};
+
+/// segmentation.*: what the segmentation stage adds to the segmenter.
+struct SegmentationStageConfig {
+  MotionGateConfig motion;  ///< segmentation.motion.*: when TOPOSLAM_MOTION says the robot stands
+};
+
+/// topology.*: how the topology stage runs the filter.
+struct TopologyStageConfig {
+  int slice_items = 256;  ///< topology.slice_items: filter work items per advance() slice, 1 .. 1000000
+  int alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
+};
+
 /// VPACK extraction; the per-subregion work runs on `pool` (borrowed; null = inline).
 class VpackFingerprintStage final : public FingerprintStage {
  public:
@@ -110,14 +130,14 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   MotionStatusCounters* motion_counters_ = nullptr;
 };
 
-/// TopologyParticleFilter with its step sliced into `slice_items` work items, run until the time budget
+/// TopologyParticleFilter with its step sliced into `stage.slice_items` work items, run until the time budget
 /// (read from `clock`) is spent. Place index = filter observation index, so numbering continues across
 /// restarts from a saved map. The map file (MapStore) carries, as application data, the representative
 /// frame of each observation.
 class ParticleFilterTopologyStage final : public TopologyStage {
  public:
   ParticleFilterTopologyStage(const TopologyFilterConfig& config, const SimilarityMeasure& similarity,
-                              const Clock& clock, int slice_items, int alternatives);
+                              const Clock& clock, const TopologyStageConfig& stage);
   ~ParticleFilterTopologyStage() override;
   /// Replaces the filter by the map saved at `path`. Throws MapStoreError (with the reason) if it is not
   /// a valid map.

@@ -34,9 +34,9 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/pipeline/bounded_queue.hpp"
 #include "toposlam/pipeline/clock.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/pipeline/stages.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 

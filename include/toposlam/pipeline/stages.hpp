@@ -18,7 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include "toposlam/fingerprint/fingerprint.hpp"
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam {
 

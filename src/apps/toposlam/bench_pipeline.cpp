@@ -182,12 +182,11 @@ RunResult runOnce(const DaemonConfig& base, const PipelineBenchOptions& o, const
     LcmPipelineSink lcm(o.lcm_url, channels, c.lcm.jpeg_quality);
     RecordingSink sink(lcm);
     LoopedFrameSource source(images, o.source_fps, o.frames, paced ? o.rate : 0.0);
-    WorkerPool pool(c.fingerprint_workers, "tsl-vpack");
+    WorkerPool pool(c.fingerprint_stage.workers, "tsl-vpack");
     VpackFingerprintStage fingerprint(c.fingerprint, &pool);
     NgramSimilarity similarity(c.similarity);
-    FiedlerSegmentationStage segmentation(c.segmentation, similarity, 600, c.segmentation_motion);
-    ParticleFilterTopologyStage topology(c.topology, similarity, clock, c.topology_slice_items,
-                                         c.topology_alternatives);
+    FiedlerSegmentationStage segmentation(c.segmentation, similarity, 600, c.segmentation_stage.motion);
+    ParticleFilterTopologyStage topology(c.topology, similarity, clock, c.topology_stage);
     Pipeline pipeline(c.pipeline, source, fingerprint, segmentation, topology, sink, clock);
     const double t0 = clock.now();
     pipeline.start();

@@ -28,7 +28,7 @@
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/io/frame_recorder.hpp"
 #include "toposlam/io/source_factory.hpp"
-#include "toposlam/io/v4l2_frame_source.hpp"
+#include "v4l2_frame_source.hpp"
 #ifdef TOPOSLAM_HAVE_LIBCAMERA
 #include "toposlam/io/libcamera_frame_source.hpp"
 #endif

@@ -12,7 +12,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -33,9 +32,10 @@
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
+#include "toposlam/platform/programs.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/segmentation/offline_mapper.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
@@ -480,18 +480,19 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       out << dot.str();
       out.commit();
     }
-    if (std::system("command -v dot >/dev/null 2>&1") == 0) {
-      const std::string dot_path = shellQuote((out_dir / "topology.dot").string());
+    if (programOnPath("dot")) {
+      const std::string dot_file = (out_dir / "topology.dot").string();
       for (const char* format : {"svg", "png"}) {
         // Drawn to a temporary name and renamed only when dot succeeded: a failing dot (a full disk) leaves
         // the earlier drawing, never a truncated one, under the real name.
         const fs::path final_path = out_dir / (std::string("topology.") + format);
         const fs::path temporary = out_dir / (std::string(".topology.") + format + ".tmp");
-        const std::string command =
-            std::string("dot -T") + format + " " + dot_path + " -o " + shellQuote(temporary.string());
+        const std::vector<std::string> command = {"dot", std::string("-T") + format, dot_file, "-o",
+                                                  temporary.string()};
         std::error_code error;
-        if (std::system(command.c_str()) != 0) {
-          std::cerr << "map: warning: `" << command << "` failed; " << final_path.string() << " not written\n";
+        if (runProgram(command) != 0) {
+          std::cerr << "map: warning: `dot -T" << format << " " << shellQuote(dot_file) << " -o "
+                    << shellQuote(temporary.string()) << "` failed; " << final_path.string() << " not written\n";
           fs::remove(temporary, error);
         } else if (fs::rename(temporary, final_path, error); error) {
           std::cerr << "map: warning: cannot rename " << temporary.string() << " to " << final_path.string() << ": "

@@ -9,21 +9,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#ifdef TOPOSLAM_HAVE_SOURCES
 #include "toposlam/io/source_factory.hpp"
-#endif
 
 namespace toposlam::cli {
 
-std::unique_ptr<FrameSource> openSource(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
-  return openFrameSource(uri);
-#else
-  throw FrameSourceError("cannot open '" + uri +
-                         "': this build has no frame sources (toposlam_sources was not "
-                         "built; see io/source_factory.hpp)");
-#endif
-}
+std::unique_ptr<FrameSource> openSource(const std::string& uri) { return openFrameSource(uri); }
 
 OutputFile openOutput(const std::filesystem::path& path) { return OutputFile(path); }
 

@@ -17,7 +17,7 @@
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/core/output_file.hpp"
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 
 namespace toposlam::cli {

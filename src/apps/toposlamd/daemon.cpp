@@ -88,13 +88,13 @@ struct Assembly {
 
   Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri) {
     source = openSource(source_uri);
-    pool = std::make_unique<WorkerPool>(config.fingerprint_workers, "tsl-vpack");
+    pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers, "tsl-vpack");
     fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get());
     similarity = std::make_unique<NgramSimilarity>(config.similarity);
     segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity, 600,
-                                                               config.segmentation_motion, config.sequence_evidence);
+                                                               config.segmentation_stage.motion, config.sequence_evidence);
     topology = std::make_unique<ParticleFilterTopologyStage>(config.topology, *similarity, clock,
-                                                             config.topology_slice_items, config.topology_alternatives);
+                                                             config.topology_stage);
   }
 };
 
@@ -231,10 +231,10 @@ int runDaemon(const DaemonConfig& config) {
   MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
   map_settings[kMapSourceKey] = mapSourceOf(config.source);
   parts.topology->setMapSettings(map_settings);
-  if (config.load_map_at_start && !pipeline_config.map_path.empty()) {
+  if (config.map.load_at_start && !pipeline_config.map_path.empty()) {
     // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
     // human under a timestamped name (never over an earlier one) and the robot starts from what is left.
-    const auto max_bytes = static_cast<std::uint64_t>(config.map_max_mb * 1024.0 * 1024.0);
+    const auto max_bytes = static_cast<std::uint64_t>(config.map.max_mb * 1024.0 * 1024.0);
     RecoveredMap recovered = MapStore::recover(pipeline_config.map_path, *parts.similarity, max_bytes);
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
@@ -243,11 +243,11 @@ int runDaemon(const DaemonConfig& config) {
       const MapSettings& recorded = recovered.map->settings;
       const bool other_source = settingDiffers(recorded, map_settings, kMapSourceKey);
       MapSettings compared = map_settings;
-      if (config.map_resume_other_source) compared.erase(kMapSourceKey);
+      if (config.map.resume_other_source) compared.erase(kMapSourceKey);
       const std::string refusal =
           MapStore::checkSettings(recorded, compared, recovered.loaded_from.string());
       if (!refusal.empty())
-        throw MapStoreError(refusal + (other_source && !config.map_resume_other_source
+        throw MapStoreError(refusal + (other_source && !config.map.resume_other_source
                                            ? " (map.resume_other_source: true or --resume-other-source continues "
                                              "it from this source; --no-map-load starts a new map)"
                                            : ""));
@@ -263,7 +263,7 @@ int runDaemon(const DaemonConfig& config) {
     }
   }
 
-  const double watchdog_s = config.watchdog ? notifier.watchdogPeriodSeconds() : 0.0;
+  const double watchdog_s = config.watchdog.enabled ? notifier.watchdogPeriodSeconds() : 0.0;
   if (!waitForNetwork(config, signals, notifier, watchdog_s, clock)) return 0;
 
   // Motion input: counted, and fed to the segmentation's MotionGate (docs/segmentation.md, "Motion-aware

@@ -18,7 +18,7 @@
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/config/config_text.hpp"
 #include "toposlam/config/daemon_config.hpp"
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/logging.hpp"
 #include "toposlam/topology/map_store.hpp"
 

@@ -6,12 +6,10 @@
 #include <filesystem>
 #include <mutex>
 
-#ifdef TOPOSLAM_HAVE_SOURCES
 #include "toposlam/io/source_factory.hpp"
 #include "toposlam/io/source_uri.hpp"
-#endif
 #ifdef TOPOSLAM_HAVE_V4L2
-#include "toposlam/io/v4l2_frame_source.hpp"
+#include "v4l2_frame_source.hpp"
 #endif
 #ifdef TOPOSLAM_HAVE_LIBCAMERA
 #include "toposlam/io/libcamera_frame_source.hpp"
@@ -36,7 +34,6 @@ void registerCameraSchemes() {
 }  // namespace
 
 std::string checkSourceUri(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
   registerCameraSchemes();
   try {
     const SourceUri parsed = parseSourceUri(uri);
@@ -55,27 +52,13 @@ std::string checkSourceUri(const std::string& uri) {
   } catch (const std::exception& e) {
     return e.what();
   }
-#else
-  return "this build has no frame sources ('" + uri + "')";
-#endif
 }
 
-std::string mapSourceOf(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
-  return sourceIdentity(uri);
-#else
-  return uri.substr(0, uri.find('?'));
-#endif
-}
+std::string mapSourceOf(const std::string& uri) { return sourceIdentity(uri); }
 
 std::unique_ptr<FrameSource> openSource(const std::string& uri) {
-#ifdef TOPOSLAM_HAVE_SOURCES
   registerCameraSchemes();
   return openFrameSource(uri);
-#else
-  throw FrameSourceError("cannot open '" + uri + "': this build has no frame sources (toposlam_sources was not "
-                         "built; see io/source_factory.hpp)");
-#endif
 }
 
 }  // namespace toposlam::daemon

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "toposlam/io/frame_source.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 namespace toposlam::daemon {
 

@@ -39,9 +39,9 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/source_uri.hpp"
-#include "toposlam/io/v4l2_device.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
+#include "v4l2_device.hpp"
 
 struct v4l2_buffer;  // <linux/videodev2.h>
 

@@ -14,7 +14,7 @@
 
 #include "fake_v4l2_device.hpp"
 #include "toposlam/io/source_factory.hpp"
-#include "toposlam/io/v4l2_frame_source.hpp"
+#include "v4l2_frame_source.hpp"
 
 using toposlam::FrameSourceError;
 using toposlam::V4l2FrameSource;

@@ -13,7 +13,7 @@ import unittest
 import toposlam_lcm
 from toposlam_lcm.udpm_reader import MAGIC_FRAGMENT, MAGIC_SHORT, Reassembler, parse_url
 
-CORPUS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fuzz", "corpus", "lcm_messages")
+CORPUS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "fuzz", "corpus", "lcm_messages")
 
 
 def short_datagram(channel, payload, sequence=7):

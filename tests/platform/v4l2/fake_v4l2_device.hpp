@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/io/v4l2_device.hpp"
+#include "v4l2_device.hpp"
 
 namespace toposlam::test {
 

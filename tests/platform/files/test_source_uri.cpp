@@ -3,8 +3,8 @@
 
 #include <filesystem>
 
-#include "toposlam/io/frame_source.hpp"
 #include "toposlam/io/source_uri.hpp"
+#include "toposlam/pipeline/frame_source.hpp"
 
 using namespace toposlam;
 
