@@ -62,6 +62,9 @@ struct DaemonConfig {
   bool load_map_at_start = true;  ///< map.load_at_start: resume from pipeline.map_path if it exists
   /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
   bool map_resume_other_source = false;
+  /// map.source_from_start: a resumed map's images: source starts from its first frame, not after the last
+  /// frame the map holds
+  bool map_source_from_start = false;
   double map_max_mb = 256;        ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
   bool watchdog = true;           ///< watchdog.enabled: ping systemd while the pipeline is healthy
   PipelineConfig pipeline;        ///< queues, threads, budgets; map.path and map.save_period_s land here
