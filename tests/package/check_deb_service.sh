@@ -6,7 +6,7 @@
 # route. In it: `dpkg -i` (the conffile /etc/toposlam/toposlam.yaml in place), the config pointed at a folder
 # of images (no camera), `systemctl start toposlamd` (Type=notify: returns once READY=1), its status, place
 # messages read with `toposlam listen`, `systemctl stop` (the final map saved, exit 0).
-# Usage: check_deb_service.sh CPACK BUILD_DIR VERSION FRAMES_DIR
+# Usage: check_deb_service.sh CPACK BUILD_DIR VERSION FRAMES_DIR   (TOPOSLAM_DEB=FILE: that package instead)
 # Exit 77 (skipped) without root, systemd-nspawn, systemd, overlayfs or dpkg-deb, or when the container does
 # not boot (an environment that cannot run one: the boot log is printed).
 set -eu
@@ -43,10 +43,14 @@ seconds() { date +%s.%N; }
 elapsed() { awk -v a="$1" -v b="$(seconds)" 'BEGIN { printf "%.1f", b - a }'; }
 t0="$(seconds)"
 
-# 1. The package, from the build tree (as check_deb.sh).
-"$cpack" -G DEB --config "$build/CPackConfig.cmake" -B "$tmp/out" >"$tmp/cpack.log" 2>&1 \
-  || { cat "$tmp/cpack.log"; fail "cpack -G DEB failed"; }
+# 1. The package, from the build tree (as check_deb.sh), or the one TOPOSLAM_DEB names (scripts/package.sh's).
 deb="toposlam_${version}_$(dpkg --print-architecture).deb"
+if [ -n "${TOPOSLAM_DEB:-}" ]; then
+  mkdir -p "$tmp/out" && cp "$TOPOSLAM_DEB" "$tmp/out/$deb"
+else
+  "$cpack" -G DEB --config "$build/CPackConfig.cmake" -B "$tmp/out" >"$tmp/cpack.log" 2>&1 \
+    || { cat "$tmp/cpack.log"; fail "cpack -G DEB failed"; }
+fi
 [ -f "$tmp/out/$deb" ] || { cat "$tmp/cpack.log"; fail "no $deb in $(ls "$tmp/out")"; }
 echo "package: $deb ($(elapsed "$t0") s)"
 
@@ -73,7 +77,13 @@ if [ -z "$leader" ]; then
   cat "$tmp/boot.log"
   skip "systemd-nspawn did not boot a container here (log above)"
 fi
-state="$(timeout 90 nsenter -t "$leader" -a systemctl is-system-running --wait 2>&1 || true)"
+# systemctl answers once the container's systemd has its socket; then it waits for the boot to finish.
+i=0
+state=""
+while [ $i -lt 300 ]; do
+  state="$(timeout 90 nsenter -t "$leader" -a systemctl is-system-running --wait 2>&1 || true)"
+  case "$state" in *"connect to bus"*) sleep 0.1; i=$((i + 1)) ;; *) break ;; esac
+done
 case "$state" in
   running|degraded) ;;
   *) cat "$tmp/boot.log"; skip "the container's systemd did not finish booting ('$state'; log above)" ;;
@@ -83,6 +93,7 @@ in_container ip link set lo multicast on
 in_container ip route add 224.0.0.0/4 dev lo  # the multicast route (docs/deploy.md, section 3)
 
 # 3. dpkg -i: installed, the conffile in place and registered as one, the unit known to systemd.
+in_container rm -f /var/lib/man-db/auto-update  # no man-db index rebuild (half a minute here), in the overlay only
 in_container dpkg -i "/mnt/deb/$deb" >"$tmp/dpkg.log" 2>&1 || { cat "$tmp/dpkg.log"; fail "dpkg -i $deb"; }
 [ "$(in_container dpkg-query -W -f='${Status} ${Version}' toposlam)" = "install ok installed $version" ] \
   || fail "dpkg-query: $(in_container dpkg-query -W -f='${Status} ${Version}' toposlam)"
