@@ -24,6 +24,7 @@ TEST_PACKAGES=(
   qemu-system-x86 busybox-static cpio kmod xz-utils v4l-utils ffmpeg  # VM camera test (tests/vm)
   libcamera-ipa libcamera-tools  # VM test: libcamera's vimc IPA module, `cam --list` (tests/vm)
   lintian  # the Debian package's check (ctest -L package)
+  systemd-container  # systemd-nspawn: the package installed and its service started under systemd (package_deb_service)
   clang libclang-rt-14-dev  # libFuzzer targets (scripts/fuzz.sh; CI fuzzes each for 20 s): clang 14, its fuzzer runtime
 )
 

@@ -168,6 +168,30 @@ std::string ImageFilesSource::describe() const {
   return "images:" + origin_ + " (" + std::to_string(files_.size()) + " frames, " + timing + ")";
 }
 
+std::string ImageFilesSource::frameName(std::int64_t sequence) const {
+  if (sequence < 0 || sequence >= static_cast<std::int64_t>(files_.size())) return {};
+  return fs::path(files_[static_cast<std::size_t>(sequence)]).filename().string();
+}
+
+std::optional<std::int64_t> ImageFilesSource::continueAfter(std::int64_t last_sequence, const std::string& last_name) {
+  if (last_name.empty()) return std::nullopt;
+  std::optional<std::int64_t> last;
+  if (frameName(last_sequence) == last_name) {
+    last = last_sequence;
+  } else {
+    // Files were added or removed before it: the same file, wherever it is now.
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(files_.size()) && !last; ++i)
+      if (frameName(i) == last_name) last = i;
+  }
+  if (!last) {
+    spdlog::warn("images: {} has no file {} (the last frame the map holds, number {}): starting from its first frame",
+                 origin_, last_name, last_sequence);
+    return std::nullopt;
+  }
+  next_index_ = static_cast<std::size_t>(*last + 1);
+  return static_cast<std::int64_t>(next_index_);
+}
+
 std::optional<Frame> ImageFilesSource::next() {
   while (next_index_ < files_.size() && !interrupted_.load()) {
     const std::size_t index = next_index_++;

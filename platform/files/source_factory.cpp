@@ -82,6 +82,10 @@ class RateLimitedSource : public FrameSource {
   FrameSourceState state() const override { return inner_->state(); }
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
+  std::string frameName(std::int64_t sequence) const override { return inner_->frameName(sequence); }
+  std::optional<std::int64_t> continueAfter(std::int64_t last_sequence, const std::string& last_name) override {
+    return inner_->continueAfter(last_sequence, last_name);
+  }
 
  private:
   std::unique_ptr<FrameSource> inner_;

@@ -220,6 +220,11 @@ std::vector<ConfigKey> makeKeys() {
                    "a map records its source (v4l2:/dev/video0, sim:office, ...); one made from another source "
                    "is refused (exit 2) unless this is true")
                   .withOption("--resume-other-source", true));
+  k.push_back(flag("map.source_from_start", AT(map.source_from_start), false,
+                   "a map made from a folder of images records the last frame it holds, and a restart from "
+                   "the same folder continues after that frame (each frame is mapped once); true reads the "
+                   "folder from its first frame again")
+                  .withOption("--source-from-start", true));
   k.push_back(real("map.save_period_s", AT(pipeline.map_save_period_s), 60.0, 0, 86400, "seconds",
                    "seconds between periodic saves")
                   .withNote("0 = only at stop, else at least 1")

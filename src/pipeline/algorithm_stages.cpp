@@ -145,6 +145,8 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   // an older run mean nothing in this one, so resumed observations show -1.
   representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);
   run_first_observation_ = filter_->observationCount();
+  last_mapped_frame_ = -1;  // where the source stands in it: the daemon says (setLastMappedFrame)
+  last_mapped_name_.clear();
   revision_ = 1;
   refresh();
 }
@@ -152,6 +154,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
 void ParticleFilterTopologyStage::enqueuePlace(const ClosedPlace& place) {
   queue_.push_back(place.representative);
   queued_frames_.push_back(place.representative_frame);
+  queued_last_frames_.push_back(place.last_frame);
   queued_evidence_.push_back(place.evidence);
 }
 
@@ -171,6 +174,11 @@ std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budge
     if (filter_->advance(slice_items_)) {
       representative_frames_.push_back(queued_frames_.front());
       queued_frames_.pop_front();
+      if (queued_last_frames_.front() > last_mapped_frame_) {
+        last_mapped_frame_ = queued_last_frames_.front();
+        last_mapped_name_ = name_of_ ? name_of_(last_mapped_frame_) : std::string();
+      }
+      queued_last_frames_.pop_front();
       ++revision_;
       refresh();
       PlaceAssignment a;
@@ -251,7 +259,14 @@ std::unique_ptr<const MapSnapshot> ParticleFilterTopologyStage::snapshotMap() co
   std::ostringstream data;
   data << "toposlamd-frames";
   for (std::int64_t f : representative_frames_) data << ' ' << f;
-  return std::make_unique<FrozenMap>(filter_->freeze(), data.str(), map_settings_);
+  MapSettings settings = map_settings_;
+  // A name that would break the settings' "key=value" lines is not recorded (the source then starts over).
+  if (last_mapped_frame_ >= 0 && !last_mapped_name_.empty() &&
+      last_mapped_name_.find_first_of("\r\n") == std::string::npos) {
+    settings[kMapSourceLastFrameKey] = std::to_string(last_mapped_frame_);
+    settings[kMapSourceLastFrameNameKey] = last_mapped_name_;
+  }
+  return std::make_unique<FrozenMap>(filter_->freeze(), data.str(), std::move(settings));
 }
 
 }  // namespace toposlam

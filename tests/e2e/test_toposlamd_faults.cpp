@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -265,4 +266,122 @@ SCENARIO("GIVEN toposlamd whose log pipe is closed (the reader gone) WHEN it run
   const int code = waitForExit(pid, 60.0);
   CHECK(code == 0);  // 141 = killed by SIGPIPE
   CHECK(fs::exists(map));
+}
+
+namespace {
+
+/// The representative frame of each place in a map file toposlamd saved (its application data,
+/// "toposlamd-frames F0 F1 ...", -1 for the places of an earlier run).
+std::vector<long long> representativeFrames(const fs::path& map) {
+  const std::string bytes = readText(map);
+  const std::string key = "toposlamd-frames";
+  const std::size_t at = bytes.find(key);
+  if (at == std::string::npos || at < 8) return {};
+  // The application data is bytes(x): its u64 size (little-endian), then x.
+  std::uint64_t size = 0;
+  for (std::size_t i = 0; i < 8; ++i) size |= std::uint64_t{static_cast<unsigned char>(bytes[at - 8 + i])} << (8 * i);
+  std::istringstream in(bytes.substr(at + key.size(), size - key.size()));
+  std::vector<long long> frames;
+  long long f = 0;
+  while (in >> f) frames.push_back(f);
+  return frames;
+}
+
+/// The map's "source.last_frame" setting (the last frame of its source it holds), -1 when it records none.
+long long lastMappedFrame(const fs::path& map) {
+  const std::string bytes = readText(map);
+  const std::string key = "source.last_frame=";  // a "key=value" line of the map's settings
+  const std::size_t at = bytes.find(key);
+  return at == std::string::npos ? -1 : std::stoll(bytes.substr(at + key.size()));
+}
+
+}  // namespace
+
+SCENARIO("GIVEN toposlamd stopped part-way through an images: folder WHEN it restarts on the same folder THEN it "
+         "continues after the last frame the map holds, so each frame is mapped once") {
+  const fs::path dir = freshDirectory("restart-continues");
+  constexpr int kFrames = 40;
+  const fs::path frames = sampleFolder(dir, kFrames);
+  const fs::path map = dir / "map.tsm";
+  std::vector<std::string> paced = daemonArgs(frames, map);
+  paced[1] += "?fps=1&rate=8";  // 1 Hz timestamps (the samples are keyframes), 8 Hz real time: SIGTERM part-way
+  const pid_t first = startDaemon(dir / "run1.log", paced);
+  REQUIRE(first > 0);
+  REQUIRE(waitForLog(dir / "run1.log", "toposlamd: running", 30.0));
+  // Until the map holds a place or two (each place message is logged at debug level only, so by time).
+  const auto started = Clock::now();
+  while (secondsSince(started) < 2.5) nap();
+  kill(first, SIGTERM);
+  REQUIRE(waitForExit(first, 30.0) == 0);
+  const long long last1 = lastMappedFrame(map);
+  const std::vector<long long> places1 = representativeFrames(map);
+  INFO("run 1: " << places1.size() << " places, last frame " << last1 << "\n" << readText(dir / "run1.log"));
+  REQUIRE(!places1.empty());
+  REQUIRE(last1 >= 0);
+  REQUIRE(last1 < kFrames - 1);
+  for (long long f : places1) CHECK(f <= last1);
+
+  // The restart reads only the frames after the last one mapped, says so, and maps them.
+  REQUIRE(runDaemon(dir / "run2.log", daemonArgs(frames, map)) == 0);
+  const std::string log2 = readText(dir / "run2.log");
+  const std::vector<long long> places2 = representativeFrames(map);
+  INFO(log2);
+  const std::string last_name = std::to_string(last1 + 1) + ".jpg";  // sample k is frame k - 1
+  CHECK_THAT(log2, Catch::Contains("continuing images:" + frames.string() + " after frame " + std::to_string(last1) +
+                                   " (" + last_name + "), the last one the map holds: skipping the " +
+                                   std::to_string(last1 + 1) + " frames already mapped"));
+  CHECK_THAT(log2, Catch::Contains("toposlamd: " + std::to_string(kFrames - 1 - last1) + " frames published"));
+  REQUIRE(places2.size() > places1.size());
+  for (std::size_t i = 0; i < places1.size(); ++i) CHECK(places2[i] == -1);  // run 1's places, resumed
+  for (std::size_t i = places1.size(); i < places2.size(); ++i) {
+    CHECK(places2[i] > last1);
+    CHECK(places2[i] < kFrames);
+  }
+  const long long last2 = lastMappedFrame(map);
+  CHECK(last2 > last1);
+  CHECK(last2 <= kFrames - 1);
+
+  // Once every frame is mapped, a restart maps nothing and ends normally (Restart=on-failure stops there)...
+  REQUIRE(runDaemon(dir / "run3.log", daemonArgs(frames, map)) == 0);
+  const std::string log3 = readText(dir / "run3.log");
+  INFO(log3);
+  if (last2 == kFrames - 1) {
+    CHECK_THAT(log3, Catch::Contains("the map holds every frame of images:" + frames.string()) &&
+                         Catch::Contains("toposlamd: 0 frames published"));
+    CHECK(representativeFrames(map).size() == places2.size());
+  }
+  CHECK(lastMappedFrame(map) == last2);  // and the map still says where the folder stands
+
+  // ...and the explicit option reads the folder from its first frame again.
+  std::vector<std::string> again = daemonArgs(frames, map);
+  again.push_back("--source-from-start");
+  REQUIRE(runDaemon(dir / "run4.log", again) == 0);
+  const std::string log4 = readText(dir / "run4.log");
+  INFO(log4);
+  CHECK_THAT(log4, Catch::Contains("reading it from its first frame again (map.source_from_start)") &&
+                       Catch::Contains("toposlamd: " + std::to_string(kFrames) + " frames published"));
+  const std::vector<long long> places4 = representativeFrames(map);
+  REQUIRE(places4.size() > places2.size());
+  CHECK(places4[places2.size()] <= last1);  // the first new place is from the start of the folder
+}
+
+SCENARIO("GIVEN a map whose last frame is not in the folder any more WHEN toposlamd restarts THEN it says so and "
+         "reads the folder from its first frame") {
+  const fs::path dir = freshDirectory("restart-other-folder");
+  const fs::path frames = sampleFolder(dir, 8);
+  const fs::path map = dir / "map.tsm";
+  REQUIRE(runDaemon(dir / "run1.log", daemonArgs(frames, map)) == 0);
+  const long long last1 = lastMappedFrame(map);
+  REQUIRE(last1 >= 0);
+  const std::string last_name = std::to_string(last1 + 1) + ".jpg";
+  for (int i = 1; i <= 8; ++i) {
+    const std::string name = std::to_string(i) + ".jpg";
+    fs::rename(frames / name, frames / std::string("b").append(name));
+  }
+  REQUIRE(runDaemon(dir / "run2.log", daemonArgs(frames, map)) == 0);
+  const std::string log2 = readText(dir / "run2.log");
+  INFO(log2);
+  CHECK_THAT(log2, Catch::Contains("images: " + frames.string() + " has no file " + last_name) &&
+                       Catch::Contains("starting from its first frame") &&
+                       Catch::Contains("toposlamd: 8 frames published"));
 }

@@ -7,7 +7,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 runtime="$(bash "$root/scripts/setup.sh" --print)" || fail "setup.sh --print failed"
 all="$(bash "$root/scripts/setup.sh" --test --print)" || fail "setup.sh --test --print failed"
 has() { printf '%s\n' "$1" | grep -qx "$2"; }
-for p in qemu-system-x86 busybox-static chromium chromium-driver ffmpeg libcamera-tools cpio lintian; do
+for p in qemu-system-x86 busybox-static chromium chromium-driver ffmpeg libcamera-tools cpio lintian systemd-container; do
   has "$runtime" "$p" && fail "test-only package $p is in the default (build + runtime) set"
   has "$all" "$p" || fail "test-only package $p is missing from --test"
 done

@@ -55,6 +55,9 @@ struct MapConfig {
   bool load_at_start = true;         ///< map.load_at_start: resume from pipeline.map_path if it exists
   /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
   bool resume_other_source = false;
+  /// map.source_from_start: a resumed map's images: source starts from its first frame, not after the
+  /// last frame the map holds
+  bool source_from_start = false;
   double max_mb = 256;               ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
 };
 

@@ -40,6 +40,11 @@ class ImageFilesSource : public FrameSource {
   void interrupt() override { interrupted_.store(true); }
   std::int64_t skippedFrames() const override { return skipped_; }
   std::int64_t frameCountHint() const override { return static_cast<std::int64_t>(files_.size()); }
+  /// The file name (without its folder) of file `sequence`; "" out of range.
+  std::string frameName(std::int64_t sequence) const override;
+  /// The file `last_sequence` when it has that name, else the first file of that name (files were added or
+  /// removed before it); nullopt when no file has it. Logs what is skipped.
+  std::optional<std::int64_t> continueAfter(std::int64_t last_sequence, const std::string& last_name) override;
   const std::vector<std::string>& files() const { return files_; }
 
  private:

@@ -70,6 +70,10 @@ class RecordingFrameSource final : public FrameSource {
   FrameSourceState state() const override { return inner_->state(); }
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
+  std::string frameName(std::int64_t sequence) const override { return inner_->frameName(sequence); }
+  std::optional<std::int64_t> continueAfter(std::int64_t last_sequence, const std::string& last_name) override {
+    return inner_->continueAfter(last_sequence, last_name);
+  }
 
   /// The writer thread's body: writes queued frames until closeWriter() and the queue is drained, or until
   /// recording stops (size bound, write error; logged once). Never throws.

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -146,6 +147,15 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   void adoptMap(LoadedMap loaded);
   /// The settings recorded in every map snapshot (MapStore::checkSettings compares them on resume).
   void setMapSettings(MapSettings settings) { map_settings_ = std::move(settings); }
+  /// How to name a frame of the source (FrameSource::frameName; any thread). With it, each snapshot records
+  /// the last frame the map holds (kMapSourceLastFrameKey, kMapSourceLastFrameNameKey) when it has a name.
+  void nameFramesWith(std::function<std::string(std::int64_t)> name_of) { name_of_ = std::move(name_of); }
+  /// The last frame the map holds so far (a resumed map's, from its settings); -1: none yet. Set before start.
+  void setLastMappedFrame(std::int64_t sequence, std::string name) {
+    last_mapped_frame_ = sequence;
+    last_mapped_name_ = std::move(name);
+  }
+  std::int64_t lastMappedFrame() const { return last_mapped_frame_; }
 
   void enqueuePlace(const ClosedPlace& place) override;
   std::optional<PlaceAssignment> advance(double budget_s) override;
@@ -168,6 +178,10 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   std::deque<std::shared_ptr<const Fingerprint>> queue_;  ///< representatives waiting for their step
   std::vector<std::int64_t> representative_frames_;        ///< per observation (-1: from an older run)
   std::deque<std::int64_t> queued_frames_;
+  std::deque<std::int64_t> queued_last_frames_;  ///< per queued place: its last frame
+  std::function<std::string(std::int64_t)> name_of_;
+  std::int64_t last_mapped_frame_ = -1;  ///< the last frame of the last place stepped (or of the resumed map)
+  std::string last_mapped_name_;         ///< its name ("" unnamed: not recorded)
   std::deque<std::vector<double>> queued_evidence_;  ///< per queued place: by earlier place of this run
   int run_first_observation_ = 0;  ///< observation of this run's first place (after a loaded map)
   std::vector<double> step_evidence_;  ///< scratch: the evidence by observation

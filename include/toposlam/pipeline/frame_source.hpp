@@ -87,6 +87,22 @@ class FrameSource {
   virtual std::int64_t skippedFrames() const { return 0; }
   /// Total frames if known in advance (files), else -1 (cameras).
   virtual std::int64_t frameCountHint() const { return -1; }
+  /// The name of frame `sequence` when the source can tell it without reading the frame (files: the file
+  /// name), else "" (cameras, the simulator). Thread-safe: any thread (a map snapshot records the name of the
+  /// last frame it holds, so that a restart continues after it: continueAfter()).
+  virtual std::string frameName(std::int64_t sequence) const {
+    (void)sequence;
+    return {};
+  }
+  /// Continues the stream after the frame `last_sequence` named `last_name` (the last frame a resumed map
+  /// holds): the frames up to it are skipped unread. Returns the sequence of the next frame (the frame count
+  /// when none is left), or std::nullopt when the source cannot (live sources) or has no such frame (another
+  /// folder under the same name): it then starts from its first frame. Call before the first next().
+  virtual std::optional<std::int64_t> continueAfter(std::int64_t last_sequence, const std::string& last_name) {
+    (void)last_sequence;
+    (void)last_name;
+    return std::nullopt;
+  }
 };
 
 }  // namespace toposlam

@@ -62,6 +62,12 @@ MapSettings fingerprintMapSettings(const VpackConfig& config);
 /// The setting naming the source a map was made from (io/source_uri.hpp, sourceIdentity: "sim:office",
 /// "v4l2:/dev/video0"). A run from another source continues the map only when told to explicitly.
 inline constexpr const char* kMapSourceKey = "source";
+/// Where the map's source stands: the sequence number and name of the last frame the map holds (the last
+/// frame of its last place). Recorded for sources that name their frames (images:), so that a restart
+/// continues after it instead of mapping the same frames again (FrameSource::continueAfter). Not compared by
+/// checkSettings (a run's own settings have no such keys).
+inline constexpr const char* kMapSourceLastFrameKey = "source.last_frame";
+inline constexpr const char* kMapSourceLastFrameNameKey = "source.last_frame_name";
 /// True when both settings have `key` and its values differ (what checkSettings would name for it).
 bool settingDiffers(const MapSettings& recorded, const MapSettings& current, const std::string& key);
 

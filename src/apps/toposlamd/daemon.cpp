@@ -190,6 +190,40 @@ std::string recordingStatus(const RecordingFrameSource& recording) {
   return text;
 }
 
+/// A resumed map from a source that names its frames (images:) records the last frame it holds: the source
+/// continues after it, so that a restart (Restart=on-failure, a reboot) maps each frame once. Unless
+/// map.source_from_start, or the source has no such frame (then it starts from its first, said in the log).
+void continueSource(const MapSettings& recorded, const DaemonConfig& config, FrameSource& source,
+                    ParticleFilterTopologyStage& topology) {
+  const auto frame = recorded.find(kMapSourceLastFrameKey);
+  const auto name = recorded.find(kMapSourceLastFrameNameKey);
+  if (frame == recorded.end() || name == recorded.end()) return;
+  std::int64_t last = -1;
+  try {
+    last = std::stoll(frame->second);
+  } catch (const std::exception&) {
+    spdlog::warn("toposlamd: the map's {} is not a frame number ('{}'): reading {} from its first frame",
+                 kMapSourceLastFrameKey, frame->second, config.source);
+    return;
+  }
+  if (config.map.source_from_start) {
+    spdlog::info("toposlamd: the map holds {} up to frame {} ({}); reading it from its first frame again "
+                 "(map.source_from_start)", config.source, last, name->second);
+    return;
+  }
+  const std::optional<std::int64_t> next = source.continueAfter(last, name->second);
+  if (!next) return;  // the source said why
+  topology.setLastMappedFrame(*next - 1, name->second);
+  const std::int64_t total = source.frameCountHint();
+  if (total >= 0 && *next >= total)
+    spdlog::info("toposlamd: the map holds every frame of {} (up to frame {}, {}): nothing left to map "
+                 "(map.source_from_start: true reads it again)", config.source, *next - 1, name->second);
+  else
+    spdlog::info("toposlamd: continuing {} after frame {} ({}), the last one the map holds: skipping the {} "
+                 "frames already mapped (map.source_from_start: true reads it from its first frame)",
+                 config.source, *next - 1, name->second, *next);
+}
+
 }  // namespace
 
 std::string resolveMapPath(const std::string& path) {
@@ -231,6 +265,8 @@ int runDaemon(const DaemonConfig& config) {
   MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
   map_settings[kMapSourceKey] = mapSourceOf(config.source);
   parts.topology->setMapSettings(map_settings);
+  FrameSource& named_source = *parts.source;
+  parts.topology->nameFramesWith([&named_source](std::int64_t sequence) { return named_source.frameName(sequence); });
   if (config.map.load_at_start && !pipeline_config.map_path.empty()) {
     // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
     // human under a timestamped name (never over an earlier one) and the robot starts from what is left.
@@ -254,10 +290,12 @@ int runDaemon(const DaemonConfig& config) {
       if (other_source)
         spdlog::warn("toposlamd: the map {} was made from {}; continuing it from {} (map.resume_other_source)",
                      recovered.loaded_from.string(), recorded.at(kMapSourceKey), map_settings.at(kMapSourceKey));
+      const MapSettings recorded_settings = recorded;
       parts.topology->adoptMap(std::move(*recovered.map));
       spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
                    parts.topology->observations(),
                    recovered.problems.empty() ? "" : ", the newest file that loads");
+      if (!other_source) continueSource(recorded_settings, config, *parts.source, *parts.topology);
     } else if (!recovered.problems.empty()) {
       spdlog::error("toposlamd: no map file of {} loads; starting a new map", pipeline_config.map_path);
     }

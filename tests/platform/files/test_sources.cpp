@@ -107,6 +107,49 @@ TEST_CASE("GIVEN a folder with a truncated JPEG and a junk PNG WHEN played THEN 
   CHECK(imageBytesLookComplete(std::vector<unsigned char>(bytes.begin(), bytes.end())));
 }
 
+TEST_CASE("GIVEN the last frame a map holds WHEN an image folder continues after it THEN the earlier files are "
+          "skipped, also when files were added before it, and an unknown file starts over", "[io][reliability]") {
+  TempFolder folder("continue");
+  for (int i : {1, 2, 3, 4, 5}) {
+    const std::string name = std::to_string(i) + ".jpg";
+    fs::copy_file(kSamples + "/" + name, folder.path / name);
+  }
+  auto sequences = [](FrameSource& source) {
+    std::vector<std::int64_t> out;
+    while (std::optional<Frame> frame = source.next()) out.push_back(frame->sequence);
+    return out;
+  };
+  {
+    std::unique_ptr<FrameSource> source = openFrameSource("images:" + folder.path.string() + "?rate=1000");
+    CHECK(source->frameName(2) == "3.jpg");
+    CHECK(source->frameName(5).empty());
+    CHECK(source->frameName(-1).empty());
+    CHECK(source->continueAfter(2, "3.jpg") == std::optional<std::int64_t>(3));  // through the rate limiter
+    CHECK(sequences(*source) == std::vector<std::int64_t>{3, 4});
+  }
+  {
+    // A file added before it: the same file, now number 3, is found by its name.
+    fs::copy_file(kSamples + "/9.jpg", folder.path / "0.jpg");
+    std::unique_ptr<FrameSource> source = openFrameSource("images:" + folder.path.string());
+    CHECK(source->continueAfter(2, "3.jpg") == std::optional<std::int64_t>(4));
+    CHECK(sequences(*source) == std::vector<std::int64_t>{4, 5});
+  }
+  {
+    // Every frame mapped: nothing left. No such file, or no name recorded: the source starts over.
+    std::unique_ptr<FrameSource> done = openFrameSource("images:" + folder.path.string());
+    CHECK(done->continueAfter(5, "5.jpg") == std::optional<std::int64_t>(6));
+    CHECK(sequences(*done).empty());
+    std::unique_ptr<FrameSource> other = openFrameSource("images:" + folder.path.string());
+    CHECK_FALSE(other->continueAfter(2, "b3.jpg").has_value());
+    CHECK_FALSE(other->continueAfter(2, "").has_value());
+    CHECK(sequences(*other).size() == 6);
+  }
+  // Live sources cannot continue (the default).
+  std::unique_ptr<FrameSource> sim = openFrameSource("sim:office?size=160x120");
+  CHECK_FALSE(sim->continueAfter(10, "x").has_value());
+  CHECK(sim->frameName(0).empty());
+}
+
 TEST_CASE("GIVEN a sim: URI WHEN opened THEN frames come at the simulated time with ground truth", "[io]") {
   std::unique_ptr<FrameSource> source = openFrameSource("sim:office?route=loop2&fps=5&size=320x240&seed=1");
   CHECK(source->frameCountHint() > 1000);
