@@ -9,6 +9,7 @@ set -euo pipefail
 BUILD_PACKAGES=(
   build-essential cmake ninja-build pkg-config ccache
   libopencv-dev libeigen3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev catch2 zlib1g-dev
+  libjpeg62-turbo-dev libpng-dev  # image files without OpenCV imgcodecs (platform/files/image_codec.cpp)
   liblcm-dev liblcm-bin liblcm-java libsystemd-dev libcamera-dev
   help2man file  # the man pages from --help; `file`: cpack's dpkg-shlibdeps step (scripts/package.sh)
 )

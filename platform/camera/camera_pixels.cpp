@@ -1,8 +1,9 @@
 // Conversion of camera buffers to the pipeline's images (camera_pixels.hpp).
 #include "camera_pixels.hpp"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "toposlam/io/image_codec.hpp"
 
 namespace toposlam {
 
@@ -35,7 +36,11 @@ cv::Mat cameraBufferToBgr(CameraPixelLayout layout, const std::uint8_t* data, st
   if (layout == CameraPixelLayout::Jpeg) {
     if (bytes == 0) return bgr;
     try {
-      bgr = cv::imdecode(cv::Mat(1, static_cast<int>(bytes), CV_8UC1, pixels), cv::IMREAD_COLOR);
+      // A frame claiming more than four times the negotiated pixels is garbage, not a picture.
+      const std::int64_t cap = std::max<std::int64_t>(std::int64_t{4} * width * height, std::int64_t{1} << 20);
+      bgr = decodeImage(data, bytes, ImageColor::Bgr, cap);
+    } catch (const ImageCodecError&) {
+      bgr.release();
     } catch (const cv::Exception&) {
       bgr.release();
     }

@@ -13,7 +13,6 @@
 #include <iterator>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "toposlam/core/natural_order.hpp"
@@ -41,11 +40,6 @@ void sortFilesNaturally(std::vector<std::string>& files) {
     if (name_a != name_b) return naturalLess(name_a, name_b);
     return naturalLess(a, b);
   });
-}
-
-std::uint32_t readLe32(const std::vector<unsigned char>& bytes, std::size_t offset) {
-  return static_cast<std::uint32_t>(bytes[offset]) | (static_cast<std::uint32_t>(bytes[offset + 1]) << 8) |
-         (static_cast<std::uint32_t>(bytes[offset + 2]) << 16) | (static_cast<std::uint32_t>(bytes[offset + 3]) << 24);
 }
 
 }  // namespace
@@ -95,27 +89,6 @@ std::vector<std::string> listImageFiles(const std::string& path_or_glob) {
   }
   sortFilesNaturally(files);
   return files;
-}
-
-bool imageBytesLookComplete(const std::vector<unsigned char>& bytes) {
-  const std::size_t n = bytes.size();
-  if (n < 16) return false;
-  if (bytes[0] == 0xFF && bytes[1] == 0xD8) {  // JPEG: the EOI marker near the end (some writers pad)
-    const std::size_t from = n > 64 ? n - 64 : 0;
-    for (std::size_t i = n - 1; i > from; --i) {
-      if (bytes[i - 1] == 0xFF && bytes[i] == 0xD9) return true;
-    }
-    return false;
-  }
-  if (bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G') {  // PNG: an IEND chunk
-    const std::size_t from = n > 64 ? n - 64 : 0;
-    for (std::size_t i = from; i + 4 <= n; ++i) {
-      if (bytes[i] == 'I' && bytes[i + 1] == 'E' && bytes[i + 2] == 'N' && bytes[i + 3] == 'D') return true;
-    }
-    return false;
-  }
-  if (bytes[0] == 'B' && bytes[1] == 'M') return readLe32(bytes, 2) <= n;  // BMP: declared size
-  return true;  // unknown format: let the decoder decide
 }
 
 ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz, std::int64_t max_pixels,
@@ -200,7 +173,7 @@ std::optional<Frame> ImageFilesSource::next() {
     // named; it never ends the stream.
     cv::Mat image;
     try {
-      image = readImageFileChecked(file, cv::IMREAD_COLOR, max_pixels_);
+      image = readImageFileChecked(file, ImageColor::Bgr, max_pixels_);
     } catch (const ImageReadError& e) {
       spdlog::warn("images: skipping {}", e.what());
     }

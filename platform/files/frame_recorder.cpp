@@ -5,9 +5,8 @@
 #include <cerrno>
 #include <cstring>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "toposlam/io/file_sources.hpp"
+#include "toposlam/io/image_codec.hpp"
 
 namespace toposlam {
 
@@ -37,10 +36,13 @@ FrameRecorder::FrameRecorder(fs::path folder, FrameRecorderConfig config)
 
 bool FrameRecorder::record(const Frame& frame) {
   if (full_ || frame.image.empty()) return false;
-  std::vector<int> parameters;
-  if (config_.format == "jpg") parameters = {cv::IMWRITE_JPEG_QUALITY, config_.jpeg_quality};
-  if (!cv::imencode("." + config_.format, frame.image, encoded_, parameters))
-    throw FrameSourceError("record: cannot encode frame " + std::to_string(frame.sequence) + " as " + config_.format);
+  try {
+    encodeImage(frame.image, config_.format == "jpg" ? ImageFormat::Jpeg : ImageFormat::Png, encoded_,
+                config_.jpeg_quality);
+  } catch (const ImageCodecError& e) {
+    throw FrameSourceError("record: cannot encode frame " + std::to_string(frame.sequence) + " as " + config_.format +
+                           ": " + e.what());
+  }
   if (bytes_ + encoded_.size() > config_.max_bytes) {
     full_ = true;
     return false;

@@ -1,5 +1,5 @@
 // Safe reading of one image file (image_file.hpp): completeness, a header-level pixel cap, decoder
-// exceptions caught.
+// errors named.
 #include "toposlam/io/image_file.hpp"
 
 #include <fcntl.h>
@@ -12,13 +12,15 @@
 #include <sstream>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-
-#include "toposlam/io/file_sources.hpp"
 
 namespace toposlam {
 
 namespace {
+
+std::uint32_t readLe32(const std::vector<unsigned char>& bytes, std::size_t offset) {
+  return static_cast<std::uint32_t>(bytes[offset]) | (static_cast<std::uint32_t>(bytes[offset + 1]) << 8) |
+         (static_cast<std::uint32_t>(bytes[offset + 2]) << 16) | (static_cast<std::uint32_t>(bytes[offset + 3]) << 24);
+}
 
 std::uint32_t be16(const unsigned char* p) { return (std::uint32_t{p[0]} << 8) | p[1]; }
 std::uint32_t be32(const unsigned char* p) { return (be16(p) << 16) | be16(p + 2); }
@@ -68,6 +70,27 @@ std::string megapixels(std::int64_t pixels) {
 
 }  // namespace
 
+bool imageBytesLookComplete(const std::vector<unsigned char>& bytes) {
+  const std::size_t n = bytes.size();
+  if (n < 16) return false;
+  if (bytes[0] == 0xFF && bytes[1] == 0xD8) {  // JPEG: the EOI marker near the end (some writers pad)
+    const std::size_t from = n > 64 ? n - 64 : 0;
+    for (std::size_t i = n - 1; i > from; --i) {
+      if (bytes[i - 1] == 0xFF && bytes[i] == 0xD9) return true;
+    }
+    return false;
+  }
+  if (bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G') {  // PNG: an IEND chunk
+    const std::size_t from = n > 64 ? n - 64 : 0;
+    for (std::size_t i = from; i + 4 <= n; ++i) {
+      if (bytes[i] == 'I' && bytes[i + 1] == 'E' && bytes[i + 2] == 'N' && bytes[i + 3] == 'D') return true;
+    }
+    return false;
+  }
+  if (bytes[0] == 'B' && bytes[1] == 'M') return readLe32(bytes, 2) <= n;  // BMP: declared size
+  return true;  // unknown format: let the decoder decide
+}
+
 std::optional<ImageHeader> readImageHeader(const unsigned char* data, std::size_t size) {
   if (size >= 24 && data[0] == 0x89 && std::memcmp(data + 1, "PNG\r\n\x1a\n", 7) == 0 &&
       std::memcmp(data + 12, "IHDR", 4) == 0)
@@ -80,7 +103,7 @@ std::optional<ImageHeader> readImageHeader(const unsigned char* data, std::size_
   return std::nullopt;
 }
 
-cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, int flags, std::int64_t max_pixels,
+cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, ImageColor color, std::int64_t max_pixels,
                          const std::string& name) {
   if (bytes.empty()) throw ImageReadError(name + ": empty file");
   if (!imageBytesLookComplete(bytes))
@@ -100,20 +123,20 @@ cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, int flags, std
   }
   cv::Mat image;
   try {
-    image = cv::imdecode(bytes, flags);
+    // The decoder checks the cap again from its own reading of the header (a JPEG whose height comes
+    // later, in a DNL marker, is only known there).
+    image = decodeImage(bytes.data(), bytes.size(), color, max_pixels);
+  } catch (const ImageCodecError& e) {
+    throw ImageReadError(name + ": not a readable image (corrupt or unsupported format): " + e.what());
   } catch (const cv::Exception& e) {
     throw ImageReadError(name + ": cannot decode it (" + e.err + ")");
   } catch (const std::bad_alloc&) {
     throw ImageReadError(name + ": cannot decode it (out of memory)");
   }
-  if (image.empty()) throw ImageReadError(name + ": not a readable image (corrupt or unsupported format)");
-  if (static_cast<std::int64_t>(image.cols) * image.rows > max_pixels)  // a format whose header we do not parse
-    throw ImageReadError(name + ": " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                         " pixels is over the cap of " + megapixels(max_pixels) + " (max_pixels)");
   return image;
 }
 
-cv::Mat readImageFileChecked(const std::string& path, int flags, std::int64_t max_pixels) {
+cv::Mat readImageFileChecked(const std::string& path, ImageColor color, std::int64_t max_pixels) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error = errno;
@@ -141,7 +164,7 @@ cv::Mat readImageFileChecked(const std::string& path, int flags, std::int64_t ma
   ::close(fd);
   if (done != bytes.size())
     throw ImageReadError(path + ": cannot read it (" + std::string(std::strerror(read_error)) + ")");
-  return decodeImageBytes(bytes, flags, max_pixels, path);
+  return decodeImageBytes(bytes, color, max_pixels, path);
 }
 
 }  // namespace toposlam

@@ -1,5 +1,5 @@
 // The frame-source registry and factory (source_factory.hpp), with the built-in schemes images:,
-// video: and sim:, plain paths, and the real-time `rate` wrapper.
+// video:, libcamera: and sim:, plain paths, and the real-time `rate` wrapper.
 #include "toposlam/io/source_factory.hpp"
 
 #include <algorithm>
@@ -129,6 +129,16 @@ std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
   return source;
 }
 
+// libcamera: too (platform/libcamera): libcamera and the ~30 libraries behind it load only for a camera.
+std::unique_ptr<FrameSource> openLibcamera(const SourceUri& uri) {
+  using Open = FrameSource* (*)(const char*, std::string*);
+  const auto open = reinterpret_cast<Open>(sourceModuleSymbol("libcamera", "toposlam_source_libcamera_open_v1"));
+  std::string error;
+  std::unique_ptr<FrameSource> source(open(uri.text.c_str(), &error));
+  if (!source) throw FrameSourceError(error);
+  return source;
+}
+
 std::unique_ptr<FrameSource> openSim(const SourceUri& uri) { return std::make_unique<SimFrameSource>(simConfigFromUri(uri)); }
 
 struct Registry {
@@ -137,6 +147,7 @@ struct Registry {
   Registry() {
     schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ&rate=HZ|recorded&max_pixels=N]"};
     schemes["video"] = {openVideo, "video:FILE[?rate=HZ|recorded]"};
+    schemes["libcamera"] = {openLibcamera, "libcamera:ID?size=WxH&buffers=N (empty ID: the first camera)"};
     schemes["sim"] = {openSim,
                       "sim:WORLD?route=R&fps=F&size=WxH&seed=S[&speed=&fov=&light=day|night|warm|cool&noise=&people=&"
                       "pitch=&moved=0|1&rate=HZ]"};

@@ -15,10 +15,10 @@
 #include <stdexcept>
 
 #include <lcm/lcm-cpp.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "toposlam/core/json_writer.hpp"
+#include "toposlam/io/image_codec.hpp"
 #include "toposlam_lcm/motion_t.hpp"
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
@@ -86,7 +86,7 @@ LcmPipelineSink::LcmPipelineSink(const std::string& url, LcmChannels channels, i
                                  const MotionStatusCounters* motion)
     : lcm_(openLcm(url)),
       channels_(std::move(channels)),
-      jpeg_params_{cv::IMWRITE_JPEG_QUALITY, jpeg_quality},
+      jpeg_quality_(jpeg_quality),
       motion_(motion) {
   buffer_.reserve(64 * 1024);
   jpeg_.reserve(32 * 1024);
@@ -118,7 +118,13 @@ void LcmPipelineSink::publish(const FrameResult& r) {
     event.thumbnail_width = place.thumbnail.cols;
     event.thumbnail_height = place.thumbnail.rows;
     jpeg_.clear();
-    if (!place.thumbnail.empty() && !cv::imencode(".jpg", place.thumbnail, jpeg_, jpeg_params_)) jpeg_.clear();
+    if (!place.thumbnail.empty()) {
+      try {
+        encodeImage(place.thumbnail, ImageFormat::Jpeg, jpeg_, jpeg_quality_);
+      } catch (const ImageCodecError&) {
+        jpeg_.clear();  // the event goes out without its picture
+      }
+    }
     event.jpeg_size = static_cast<std::int32_t>(jpeg_.size());
     event.jpeg.assign(jpeg_.begin(), jpeg_.end());
     event.map_revision = e.map_revision;

@@ -6,9 +6,9 @@
 #include <fstream>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "toposlam/eval/json_reader.hpp"
+#include "toposlam/io/image_file.hpp"
 
 namespace toposlam::eval {
 
@@ -303,9 +303,14 @@ std::vector<TimingRow> loadTiming(const std::string& path) {
 }
 
 LoopClosureMatrix loadLoopClosureImage(const std::string& path) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty())
-    throw RunFileError(path + ": cannot read as an image (expected a BMP/PNG loop-closure matrix)");
+  cv::Mat image;
+  try {
+    image = readImageFileChecked(path, ImageColor::Grey);
+  } catch (const ImageReadError& e) {
+    std::string reason = e.what();  // "PATH: why"
+    if (reason.rfind(path + ": ", 0) == 0) reason.erase(0, path.size() + 2);
+    throw RunFileError(path + ": cannot read as an image (expected a BMP/PNG loop-closure matrix): " + reason);
+  }
   if (image.rows != image.cols) {
     throw RunFileError(path + ": loop-closure matrix must be square, got " + std::to_string(image.cols) +
                        "x" + std::to_string(image.rows));

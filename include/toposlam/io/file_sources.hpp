@@ -23,9 +23,7 @@ bool isVideoFileName(const std::string& name);
 /// The image files of a folder, or the matches of a glob, or a single image file, in natural order.
 /// Throws FrameSourceError when nothing matches.
 std::vector<std::string> listImageFiles(const std::string& path_or_glob);
-/// True when the bytes of an image file look complete: JPEG ends with the EOI marker, PNG with IEND,
-/// BMP is as long as its header says. (Decoders often accept truncated files and fill the rest grey.)
-bool imageBytesLookComplete(const std::vector<unsigned char>& bytes);
+/// imageBytesLookComplete(): image_file.hpp.
 
 class ImageFilesSource : public FrameSource {
  public:

@@ -1,7 +1,7 @@
 // Reading one image file safely: the whole file is read once (up to a size cap), refused when it looks
 // truncated (a JPEG without its end marker decodes as a half-grey frame), its width and height are read
 // from the header (PNG IHDR, JPEG SOFn, BMP info header) and checked against a pixel cap *before* any
-// decoding, and the decoder's own exceptions become an ImageReadError naming the file. A small file that
+// decoding (image_codec.hpp: JPEG, PNG, BMP), and the decoder's errors become an ImageReadError naming the file. A small file that
 // claims 65500x65500 pixels is refused in microseconds instead of asking the decoder for 12 GB.
 // Reentrant; no state.
 #pragma once
@@ -14,6 +14,8 @@
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
+
+#include "toposlam/io/image_codec.hpp"
 
 namespace toposlam {
 
@@ -33,16 +35,21 @@ struct ImageHeader {
   std::int64_t height = 0;
 };
 
+/// True when the bytes of an image file look complete: JPEG ends with the EOI marker, PNG with IEND,
+/// BMP is as long as its header says. (Decoders often accept truncated files and fill the rest grey.)
+bool imageBytesLookComplete(const std::vector<unsigned char>& bytes);
+
 /// Width and height from the header of PNG, JPEG or BMP bytes, without decoding. nullopt when the bytes
 /// are none of these or the header does not say (the decoder then decides).
 std::optional<ImageHeader> readImageHeader(const unsigned char* data, std::size_t size);
 
-/// Decodes file bytes (cv::imdecode `flags`) after the completeness and pixel-cap checks. Throws
+/// Decodes file bytes (decodeImage, as `color`) after the completeness and pixel-cap checks. Throws
 /// ImageReadError "<name>: <reason>".
-cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, int flags, std::int64_t max_pixels,
+cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, ImageColor color, std::int64_t max_pixels,
                          const std::string& name);
 
 /// Reads and decodes `path` (see decodeImageBytes). Throws ImageReadError "<path>: <reason>".
-cv::Mat readImageFileChecked(const std::string& path, int flags, std::int64_t max_pixels = kDefaultMaxImagePixels);
+cv::Mat readImageFileChecked(const std::string& path, ImageColor color,
+                             std::int64_t max_pixels = kDefaultMaxImagePixels);
 
 }  // namespace toposlam

@@ -1,8 +1,9 @@
 // Opening frame sources by URI, through a registry of scheme -> opener function.
 //
-// Built in: `images:PATH_OR_GLOB`, `video:FILE`, `sim:WORLD?route=R&fps=F&size=WxH&seed=S&...`, and a
-// plain path (a folder -> images, a video file -> video, an image file -> images). Other platform
-// adapters (v4l2, libcamera) call registerFrameSourceScheme() once at start-up, before opening.
+// Built in: `images:PATH_OR_GLOB`, `video:FILE`, `libcamera:ID?...` (both through modules loaded on first
+// use: source_modules.hpp), `sim:WORLD?route=R&fps=F&size=WxH&seed=S&...`, and a plain path (a folder ->
+// images, a video file -> video, an image file -> images). Other platform adapters (v4l2) call
+// registerFrameSourceScheme() once at start-up, before opening.
 // The common query key `rate=HZ` plays the source in real time at that rate (the returned source sleeps
 // between frames); `rate=recorded` plays it at the pace of its own frame timestamps (a recording made by
 // `toposlam capture --record`, whose timestamps.csv the images: source reads); without it frames come as

@@ -139,6 +139,8 @@ void addBenchFingerprint(CLI::App& bench) {
   cmd->callback([options] { runFingerprintBench(*options); });
 }
 
+void addBenchStartup(CLI::App& bench);  // bench_startup.cpp
+
 void addBenchCommand(CLI::App& app) {
   auto* bench = app.add_subcommand("bench", "Benchmarks: print timings, fail nothing");
   bench->require_subcommand(1);
@@ -149,6 +151,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchMatching(*bench);
   addBenchPipeline(*bench);
   addBenchMapSize(*bench);
+  addBenchStartup(*bench);
 }
 
 }  // namespace toposlam::cli

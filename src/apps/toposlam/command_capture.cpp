@@ -3,8 +3,8 @@
 // rate, and the age of each frame when it came out of the source: now on CLOCK_MONOTONIC minus the
 // driver's buffer timestamp, i.e. driver-to-application latency, meaningful when the driver stamps
 // buffers with the monotonic clock as V4L2 drivers normally do). It is how the VM test and users check that a
-// camera works before running the daemon. Registering this command also registers the `v4l2:` and
-// `libcamera:` schemes with openFrameSource(). Other source URIs (sim:, images:, video:) are read too (their
+// camera works before running the daemon. Registering this command also registers the `v4l2:` scheme
+// with openFrameSource() (`libcamera:` is the factory's own, a module loaded on first use). Other source URIs (sim:, images:, video:) are read too (their
 // age_ms is 0: their timestamps are not the monotonic clock).
 //
 // --record DIR writes the frames and their timestamps into DIR (io/frame_recorder.hpp): "record on the
@@ -29,9 +29,6 @@
 #include "toposlam/io/frame_recorder.hpp"
 #include "toposlam/io/source_factory.hpp"
 #include "v4l2_frame_source.hpp"
-#ifdef TOPOSLAM_HAVE_LIBCAMERA
-#include "toposlam/io/libcamera_frame_source.hpp"
-#endif
 
 namespace toposlam::cli {
 
@@ -91,15 +88,11 @@ void runCapture(const CaptureOptions& options) {
     dropped = [raw] { return raw->droppedFrames(); };
     source = std::move(v4l2);
   } else if (options.uri.rfind("libcamera:", 0) == 0) {
-#ifdef TOPOSLAM_HAVE_LIBCAMERA
-    auto camera = std::make_unique<LibcameraFrameSource>(parseLibcameraUri(options.uri));
-    LibcameraFrameSource* raw = camera.get();
+    // Opened through its module (loaded here, on first use); its counters come through FrameSource.
+    source = openFrameSource(options.uri);
+    FrameSource* raw = source.get();
     request_stop = [raw] { raw->interrupt(); };
-    dropped = [raw] { return raw->droppedFrames(); };
-    source = std::move(camera);
-#else
-    throw std::runtime_error("this toposlam was built without libcamera (install libcamera-dev and rebuild)");
-#endif
+    dropped = [raw] { return raw->state().dropped; };
   } else {
     source = openFrameSource(options.uri);
     FrameSource* raw = source.get();
@@ -215,9 +208,6 @@ void runCapture(const CaptureOptions& options) {
 void addCaptureCommand(CLI::App& app) {
   // Cameras become openable by URI (openFrameSource) for every other command too.
   registerV4l2FrameSourceScheme();
-#ifdef TOPOSLAM_HAVE_LIBCAMERA
-  registerLibcameraFrameSourceScheme();
-#endif
   auto options = std::make_shared<CaptureOptions>();
   CLI::App* command = app.add_subcommand("capture",
                                          "Read frames from a camera and print their sequence numbers "

@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
@@ -26,6 +25,7 @@
 #include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"
+#include "toposlam/io/image_file.hpp"
 #include "lcmlog_run_folder.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/config/config_path.hpp"
@@ -126,25 +126,32 @@ std::vector<fs::path> thumbnailPaths(const eval::RunData& run, const std::vector
   return paths;
 }
 
+/// A picture of the run as BGR; empty when it cannot be read (the report shows it without).
+cv::Mat readPicture(const fs::path& path) {
+  try {
+    return readImageFileChecked(path.string(), ImageColor::Bgr);
+  } catch (const ImageReadError&) {
+    return {};
+  }
+}
+
 std::string thumbnailDataUri(const fs::path& path) {
-  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  const cv::Mat image = readPicture(path);
   if (image.empty()) return "";
   const int width = 160;
   const int height = std::max(1, image.rows * width / std::max(1, image.cols));
   cv::Mat small;
   cv::resize(image, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
-  std::vector<std::uint8_t> jpeg;
-  cv::imencode(".jpg", small, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  const std::vector<std::uint8_t> jpeg = encodeImage(small, ImageFormat::Jpeg, 80);
   return "data:image/jpeg;base64," + eval::base64Encode(jpeg);
 }
 
 /// A picture as a PNG data URI, at most 560 px wide; empty when it cannot be read.
 std::string pictureDataUri(const fs::path& path) {
-  cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  cv::Mat image = readPicture(path);
   if (image.empty()) return "";
   if (image.cols > 560) cv::resize(image, image, cv::Size(560, std::max(1, image.rows * 560 / image.cols)), 0, 0, cv::INTER_AREA);
-  std::vector<std::uint8_t> png;
-  cv::imencode(".png", image, png);
+  const std::vector<std::uint8_t> png = encodeImage(image, ImageFormat::Png);
   return "data:image/png;base64," + eval::base64Encode(png);
 }
 

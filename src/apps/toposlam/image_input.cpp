@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "toposlam/core/natural_order.hpp"
@@ -16,7 +15,7 @@ namespace toposlam::cli {
 cv::Mat readImageFile(const std::string& path) {
   // ANYCOLOR without ANYDEPTH: 8-bit, grey kept as one channel, colour as BGR (alpha dropped). A truncated
   // file (a JPEG without its end marker) or one over the pixel cap is refused, not decoded half grey.
-  return readImageFileChecked(path, cv::IMREAD_ANYCOLOR);
+  return readImageFileChecked(path, ImageColor::AsStored);
 }
 
 Fingerprint fingerprintImage(const VpackExtractor& extractor, const cv::Mat& image, const std::string& path) {
@@ -53,8 +52,12 @@ std::vector<cv::Mat> loadSampleFrames(const std::string& folder, cv::Size size) 
   sortNatural(names);
   std::vector<cv::Mat> frames;
   for (const auto& name : names) {
-    cv::Mat image = cv::imread(name, cv::IMREAD_COLOR);
-    if (image.empty()) continue;
+    cv::Mat image;
+    try {
+      image = readImageFileChecked(name, ImageColor::Bgr);
+    } catch (const ImageReadError&) {
+      continue;
+    }
     if (!size.empty() && image.size() != size) cv::resize(image, image, size, 0, 0, cv::INTER_AREA);
     frames.push_back(image);
   }

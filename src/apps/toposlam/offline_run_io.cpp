@@ -7,7 +7,7 @@
 #include <system_error>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "toposlam/io/image_codec.hpp"
 
 #include "toposlam/io/source_factory.hpp"
 
@@ -18,14 +18,14 @@ std::unique_ptr<FrameSource> openSource(const std::string& uri) { return openFra
 OutputFile openOutput(const std::filesystem::path& path) { return OutputFile(path); }
 
 void writeImageFile(const std::filesystem::path& path, const cv::Mat& image) {
+  const std::optional<ImageFormat> format = imageFormatOfPath(path.string());
+  if (!format) throw OutputFileError(path.string() + ": cannot encode the image (name it .png, .jpg or .bmp)");
   std::vector<unsigned char> encoded;
-  bool ok = false;
   try {
-    ok = cv::imencode(path.extension().string(), image, encoded);
-  } catch (const cv::Exception& e) {
-    throw OutputFileError(path.string() + ": cannot encode the image: " + e.err);
+    encodeImage(image, *format, encoded);
+  } catch (const ImageCodecError& e) {
+    throw OutputFileError(path.string() + ": cannot encode the image: " + e.what());
   }
-  if (!ok) throw OutputFileError(path.string() + ": cannot encode the image");
   OutputFile out(path);
   out.write(reinterpret_cast<const char*>(encoded.data()), static_cast<std::streamsize>(encoded.size()));
   out.commit();

@@ -1,6 +1,7 @@
-// See sources.hpp. The camera adapters register their URI schemes (v4l2:, libcamera:) once, before the
-// first source is opened. A V4L2 camera that is not plugged in yet does not stop the service: it starts
-// reconnecting (status "camera reconnecting") and opens the camera when it appears (URI wait=0 opts out).
+// See sources.hpp. The V4L2 adapter registers its URI scheme (v4l2:) once, before the first source is
+// opened (libcamera: is the factory's own, through a module loaded on first use). A V4L2 camera that is
+// not plugged in yet does not stop the service: it starts reconnecting (status "camera reconnecting") and
+// opens the camera when it appears (URI wait=0 opts out).
 #include "sources.hpp"
 
 #include <filesystem>
@@ -10,9 +11,6 @@
 #include "toposlam/io/source_uri.hpp"
 #ifdef TOPOSLAM_HAVE_V4L2
 #include "v4l2_frame_source.hpp"
-#endif
-#ifdef TOPOSLAM_HAVE_LIBCAMERA
-#include "toposlam/io/libcamera_frame_source.hpp"
 #endif
 
 namespace toposlam::daemon {
@@ -24,9 +22,6 @@ void registerCameraSchemes() {
   std::call_once(registered, [] {
 #ifdef TOPOSLAM_HAVE_V4L2
     registerV4l2FrameSourceScheme(/*wait_at_start=*/true);
-#endif
-#ifdef TOPOSLAM_HAVE_LIBCAMERA
-    registerLibcameraFrameSourceScheme();
 #endif
   });
 }

@@ -100,8 +100,8 @@ TEST_CASE("GIVEN a small JPEG claiming 65500x65500 pixels WHEN read THEN it is r
   const fs::path huge = folder.path / "huge.jpg";
   writeBytes(huge, jpegClaiming(65500, 65500));
   CHECK(fs::file_size(huge) < 64 * 1024);
-  CHECK_THROWS_AS(readImageFileChecked(huge.string(), cv::IMREAD_COLOR), ImageReadError);
-  CHECK_THROWS_WITH(readImageFileChecked(huge.string(), cv::IMREAD_COLOR),
+  CHECK_THROWS_AS(readImageFileChecked(huge.string(), ImageColor::Bgr), ImageReadError);
+  CHECK_THROWS_WITH(readImageFileChecked(huge.string(), ImageColor::Bgr),
                     Catch::Contains(huge.string()) && Catch::Contains("65500x65500 pixels") &&
                         Catch::Contains("over the cap"));
 }
@@ -111,14 +111,14 @@ TEST_CASE("GIVEN an 8000x8000 PNG WHEN read with the default cap THEN refused, a
   TempFolder folder("big-png");
   const fs::path big = folder.path / "big.png";
   writeBytes(big, pngClaiming(8000, 8000));
-  CHECK_THROWS_WITH(readImageFileChecked(big.string(), cv::IMREAD_COLOR),
+  CHECK_THROWS_WITH(readImageFileChecked(big.string(), ImageColor::Bgr),
                     Catch::Contains("8000x8000 pixels (64.0 megapixels) is over the cap of 16.8 megapixels"));
   // Sides near 2^32: refused without overflowing the product (found by fuzz_image_header).
   writeBytes(big, pngClaiming(0xFFFFFFFFu, 0xFFFFFFF0u));
-  CHECK_THROWS_WITH(readImageFileChecked(big.string(), cv::IMREAD_COLOR), Catch::Contains("a side alone"));
+  CHECK_THROWS_WITH(readImageFileChecked(big.string(), ImageColor::Bgr), Catch::Contains("a side alone"));
   writeBytes(big, pngClaiming(8000, 8000));
   // Under a cap it fits, the decoder gets it (and refuses the stale checksum: an error, not a crash).
-  CHECK_THROWS_AS(readImageFileChecked(big.string(), cv::IMREAD_COLOR, 100'000'000), ImageReadError);
+  CHECK_THROWS_AS(readImageFileChecked(big.string(), ImageColor::Bgr, 100'000'000), ImageReadError);
 }
 
 TEST_CASE("GIVEN half a JPEG without its end marker WHEN read THEN it is refused, not decoded half grey",
@@ -128,11 +128,11 @@ TEST_CASE("GIVEN half a JPEG without its end marker WHEN read THEN it is refused
   bytes.resize(bytes.size() / 2);
   const fs::path half = folder.path / "half.jpg";
   writeBytes(half, bytes);
-  CHECK_THROWS_WITH(readImageFileChecked(half.string(), cv::IMREAD_ANYCOLOR),
+  CHECK_THROWS_WITH(readImageFileChecked(half.string(), ImageColor::AsStored),
                     Catch::Contains(half.string()) && Catch::Contains("truncated"));
-  CHECK(readImageFileChecked(kSamples + "/5.jpg", cv::IMREAD_ANYCOLOR).cols == 512);
-  CHECK_THROWS_WITH(readImageFileChecked(folder.path.string(), cv::IMREAD_ANYCOLOR), Catch::Contains("is a folder"));
-  CHECK_THROWS_WITH(readImageFileChecked((folder.path / "none.jpg").string(), cv::IMREAD_ANYCOLOR),
+  CHECK(readImageFileChecked(kSamples + "/5.jpg", ImageColor::AsStored).cols == 512);
+  CHECK_THROWS_WITH(readImageFileChecked(folder.path.string(), ImageColor::AsStored), Catch::Contains("is a folder"));
+  CHECK_THROWS_WITH(readImageFileChecked((folder.path / "none.jpg").string(), ImageColor::AsStored),
                     Catch::Contains("no such file"));
 }
 

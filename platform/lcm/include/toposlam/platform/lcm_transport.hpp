@@ -64,7 +64,7 @@ class LcmPipelineSink final : public PipelineSink {
 
   std::unique_ptr<lcm::LCM> lcm_;
   LcmChannels channels_;
-  std::vector<int> jpeg_params_;
+  int jpeg_quality_;  ///< of the place thumbnails, 1..100
   const MotionStatusCounters* motion_;
   std::vector<std::uint8_t> buffer_;  ///< encoding scratch, grows to the largest message once
   std::vector<std::uint8_t> jpeg_;
