@@ -9,9 +9,7 @@
 
 #include "toposlam/io/source_factory.hpp"
 #include "toposlam/io/source_uri.hpp"
-#ifdef TOPOSLAM_HAVE_V4L2
 #include "v4l2_frame_source.hpp"
-#endif
 
 namespace toposlam::daemon {
 
@@ -20,9 +18,7 @@ namespace {
 void registerCameraSchemes() {
   static std::once_flag registered;
   std::call_once(registered, [] {
-#ifdef TOPOSLAM_HAVE_V4L2
     registerV4l2FrameSourceScheme(/*wait_at_start=*/true);
-#endif
   });
 }
 
