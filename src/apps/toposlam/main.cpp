@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/platform/logging.hpp"
+#include "toposlam/platform/opencv_runtime.hpp"
 
 namespace {
 
@@ -78,4 +79,7 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) { return checkStandardOutput(run(argc, argv)); }
+int main(int argc, char** argv) {
+  toposlam::keepOpenCvOffOpenCl();
+  return checkStandardOutput(run(argc, argv));
+}

@@ -20,6 +20,7 @@
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/logging.hpp"
+#include "toposlam/platform/opencv_runtime.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace {
@@ -37,6 +38,7 @@ int startError(const std::exception& e, int code) {
 // config error: a bad option, config, source or map that no restart fixes (the unit's
 // RestartPreventExitStatus=2).
 int main(int argc, char** argv) {
+  toposlam::keepOpenCvOffOpenCl();  // before any OpenCV call
   // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
