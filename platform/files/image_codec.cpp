@@ -24,13 +24,16 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "byte_order.hpp"
+
 namespace toposlam {
 
 namespace {
 
-std::uint32_t be16(const unsigned char* p) { return (std::uint32_t{p[0]} << 8) | p[1]; }
-std::uint32_t le16(const unsigned char* p) { return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8); }
-std::uint32_t le32(const unsigned char* p) { return le16(p) | (le16(p + 2) << 16); }
+using bytes::be16;
+using bytes::be32;
+using bytes::le16;
+using bytes::le32;
 
 void checkPixels(std::int64_t width, std::int64_t height, std::int64_t max_pixels) {
   if (width <= 0 || height <= 0)
@@ -116,7 +119,7 @@ int exifOrientation(const jpeg_decompress_struct& info) {
     const bool little = tiff[0] == 'I' && tiff[1] == 'I';
     if (!little && !(tiff[0] == 'M' && tiff[1] == 'M')) return 1;
     const auto u16 = [&](std::size_t at) { return little ? le16(tiff + at) : be16(tiff + at); };
-    const auto u32 = [&](std::size_t at) { return little ? le32(tiff + at) : (be16(tiff + at) << 16) | be16(tiff + at + 2); };
+    const auto u32 = [&](std::size_t at) { return little ? le32(tiff + at) : be32(tiff + at); };
     const std::size_t ifd = u32(4);
     if (ifd + 2 > n) return 1;
     const std::size_t entries = u16(ifd);
@@ -295,7 +298,6 @@ cv::Mat decodeBmp(const unsigned char* data, std::size_t size, ImageColor color,
   const bool grey_palette = !palette.empty() && std::all_of(palette.begin(), palette.end(), [](const cv::Vec3b& c) {
     return c[0] == c[1] && c[1] == c[2];
   });
-  const bool stored_grey = grey_palette;
   cv::Mat bgr(static_cast<int>(height), static_cast<int>(width), CV_8UC3);
   for (int y = 0; y < bgr.rows; ++y) {
     const unsigned char* row = data + pixels_at + stride * static_cast<std::size_t>(top_down ? y : bgr.rows - 1 - y);
@@ -318,7 +320,7 @@ cv::Mat decodeBmp(const unsigned char* data, std::size_t size, ImageColor color,
       }
     }
   }
-  if (color == ImageColor::Bgr || (color == ImageColor::AsStored && !stored_grey)) return bgr;
+  if (color == ImageColor::Bgr || (color == ImageColor::AsStored && !grey_palette)) return bgr;
   return greyFromBgr(bgr);
 }
 

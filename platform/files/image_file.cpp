@@ -13,21 +13,16 @@
 
 #include <opencv2/core.hpp>
 
+#include "byte_order.hpp"
+
 namespace toposlam {
 
 namespace {
 
-std::uint32_t readLe32(const std::vector<unsigned char>& bytes, std::size_t offset) {
-  return static_cast<std::uint32_t>(bytes[offset]) | (static_cast<std::uint32_t>(bytes[offset + 1]) << 8) |
-         (static_cast<std::uint32_t>(bytes[offset + 2]) << 16) | (static_cast<std::uint32_t>(bytes[offset + 3]) << 24);
-}
-
-std::uint32_t be16(const unsigned char* p) { return (std::uint32_t{p[0]} << 8) | p[1]; }
-std::uint32_t be32(const unsigned char* p) { return (be16(p) << 16) | be16(p + 2); }
-std::int32_t le32(const unsigned char* p) {
-  return static_cast<std::int32_t>(std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) |
-                                   (std::uint32_t{p[3]} << 24));
-}
+using bytes::be16;
+using bytes::be32;
+// BMP stores its width and height signed (a negative height: rows top-down).
+std::int32_t le32(const unsigned char* p) { return static_cast<std::int32_t>(bytes::le32(p)); }
 
 bool isJpegFrameMarker(unsigned char m) {
   // SOF0..SOF15 except DHT (C4), JPG (C8) and DAC (CC).
@@ -87,7 +82,7 @@ bool imageBytesLookComplete(const std::vector<unsigned char>& bytes) {
     }
     return false;
   }
-  if (bytes[0] == 'B' && bytes[1] == 'M') return readLe32(bytes, 2) <= n;  // BMP: declared size
+  if (bytes[0] == 'B' && bytes[1] == 'M') return bytes::le32(bytes.data() + 2) <= n;  // BMP: declared size
   return true;  // unknown format: let the decoder decide
 }
 

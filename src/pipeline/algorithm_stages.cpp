@@ -152,10 +152,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
 }
 
 void ParticleFilterTopologyStage::enqueuePlace(const ClosedPlace& place) {
-  queue_.push_back(place.representative);
-  queued_frames_.push_back(place.representative_frame);
-  queued_last_frames_.push_back(place.last_frame);
-  queued_evidence_.push_back(place.evidence);
+  queue_.push_back(QueuedPlace{place.representative, place.representative_frame, place.last_frame, place.evidence});
 }
 
 std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budget_s) {
@@ -164,21 +161,20 @@ std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budge
     if (!filter_->stepInProgress()) {
       if (queue_.empty()) return std::nullopt;
       // Evidence by earlier place of this run -> by filter observation.
-      const std::vector<double>& by_place = queued_evidence_.front();
+      // The place stays at the front of the queue until its step is done.
+      const std::vector<double>& by_place = queue_.front().evidence;
       step_evidence_.assign(by_place.empty() ? 0 : static_cast<std::size_t>(run_first_observation_), 0.0);
       step_evidence_.insert(step_evidence_.end(), by_place.begin(), by_place.end());
-      filter_->beginStep(queue_.front(), step_evidence_);
-      queue_.pop_front();
-      queued_evidence_.pop_front();
+      filter_->beginStep(queue_.front().representative, step_evidence_);
     }
     if (filter_->advance(slice_items_)) {
-      representative_frames_.push_back(queued_frames_.front());
-      queued_frames_.pop_front();
-      if (queued_last_frames_.front() > last_mapped_frame_) {
-        last_mapped_frame_ = queued_last_frames_.front();
+      const QueuedPlace& done = queue_.front();
+      representative_frames_.push_back(done.representative_frame);
+      if (done.last_frame > last_mapped_frame_) {
+        last_mapped_frame_ = done.last_frame;
         last_mapped_name_ = name_of_ ? name_of_(last_mapped_frame_) : std::string();
       }
-      queued_last_frames_.pop_front();
+      queue_.pop_front();
       ++revision_;
       refresh();
       PlaceAssignment a;

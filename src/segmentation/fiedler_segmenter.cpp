@@ -178,9 +178,8 @@ void FiedlerSegmenter::samplePlaceFrame(int slot) {
     place_sample_affinity_(j, i) = value;
   }
   place_sample_affinity_(i, i) = 0.0;
-  // `degree` holds the sample's weight: the frames it stands for at the current rate.
-  place_samples_.push_back(Candidate{slot_frame_[s], static_cast<double>(sample_stride_), slot_time_[s],
-                                     slot_fingerprint_[s], slot_fingerprint_[s]->keypointCount()});
+  place_samples_.push_back(Candidate{slot_frame_[s], 0.0, slot_time_[s], slot_fingerprint_[s],
+                                     slot_fingerprint_[s]->keypointCount(), static_cast<double>(sample_stride_)});
 }
 
 void FiedlerSegmenter::thinPlaceSamples() {
@@ -191,7 +190,7 @@ void FiedlerSegmenter::thinPlaceSamples() {
   for (Eigen::Index a = 0; a < kept; ++a) {
     for (Eigen::Index b = 0; b < kept; ++b) place_sample_affinity_(a, b) = place_sample_affinity_(2 * a, 2 * b);
     place_samples_[static_cast<std::size_t>(a)] = std::move(place_samples_[static_cast<std::size_t>(2 * a)]);
-    place_samples_[static_cast<std::size_t>(a)].degree *= 2.0;  // it now stands for its dropped neighbour too
+    place_samples_[static_cast<std::size_t>(a)].weight *= 2.0;  // it now stands for its dropped neighbour too
   }
   place_samples_.resize(static_cast<std::size_t>(kept));
   sample_interval_s_ *= 2.0;
@@ -206,7 +205,7 @@ std::optional<std::pair<int, double>> FiedlerSegmenter::placeMedoid(int count) c
   for (int i = 0; i < count; ++i) {
     Candidate candidate = place_samples_[static_cast<std::size_t>(i)];
     candidate.degree = 0.0;
-    for (int j = 0; j < count; ++j) candidate.degree += place_sample_affinity_(i, j) * place_samples_[static_cast<std::size_t>(j)].degree;
+    for (int j = 0; j < count; ++j) candidate.degree += place_sample_affinity_(i, j) * place_samples_[static_cast<std::size_t>(j)].weight;
     if (!best || preferred(candidate, best_candidate)) {
       best = std::make_pair(i, candidate.degree);
       best_candidate = std::move(candidate);

@@ -99,8 +99,16 @@ TEST_CASE("GIVEN bad input WHEN `toposlam segment` runs THEN it fails with an ac
     const Result r = runToposlam("segment images:" + std::string(TOPOSLAM_SAMPLES_DIR) + "/samples --out " +
                                  out.string() + " --cut middle --quiet");
     INFO(r.output);
-    CHECK(r.exit_code != 0);
+    CHECK(r.exit_code == 2);  // a usage error
     CHECK(r.output.find("window-split") != std::string::npos);
+  }
+  SECTION("an unknown representative rule") {
+    const Result r = runToposlam("segment images:" + std::string(TOPOSLAM_SAMPLES_DIR) + "/samples --out " +
+                                 out.string() + " --representative middle --quiet");
+    INFO(r.output);
+    CHECK(r.exit_code == 2);  // a usage error
+    CHECK(r.output.find("--representative") != std::string::npos);
+    CHECK(r.output.find("place-medoid") != std::string::npos);
   }
   SECTION("an output folder that cannot be created") {
     const Result r = runToposlam("segment images:" + std::string(TOPOSLAM_SAMPLES_DIR) +

@@ -175,14 +175,18 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   int alternatives_;
   CandidateSelectionConfig candidates_;  ///< re-applied to a loaded map
   std::unique_ptr<TopologyParticleFilter> filter_;
-  std::deque<std::shared_ptr<const Fingerprint>> queue_;  ///< representatives waiting for their step
-  std::vector<std::int64_t> representative_frames_;        ///< per observation (-1: from an older run)
-  std::deque<std::int64_t> queued_frames_;
-  std::deque<std::int64_t> queued_last_frames_;  ///< per queued place: its last frame
+  /// A closed place waiting for (or in) its filter step: the front one while a step is in progress.
+  struct QueuedPlace {
+    std::shared_ptr<const Fingerprint> representative;
+    std::int64_t representative_frame = -1;
+    std::int64_t last_frame = -1;
+    std::vector<double> evidence;  ///< by earlier place of this run (ClosedPlace::evidence)
+  };
+  std::deque<QueuedPlace> queue_;
+  std::vector<std::int64_t> representative_frames_;  ///< per observation (-1: from an older run)
   std::function<std::string(std::int64_t)> name_of_;
   std::int64_t last_mapped_frame_ = -1;  ///< the last frame of the last place stepped (or of the resumed map)
   std::string last_mapped_name_;         ///< its name ("" unnamed: not recorded)
-  std::deque<std::vector<double>> queued_evidence_;  ///< per queued place: by earlier place of this run
   int run_first_observation_ = 0;  ///< observation of this run's first place (after a loaded map)
   std::vector<double> step_evidence_;  ///< scratch: the evidence by observation
   std::int64_t revision_ = 0;

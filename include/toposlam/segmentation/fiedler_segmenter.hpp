@@ -193,6 +193,7 @@ class FiedlerSegmenter {
     double time_s;
     std::shared_ptr<const Fingerprint> fingerprint;
     int keypoints;
+    double weight = 1.0;  ///< PlaceMedoid samples: the frames it stands for at the sampling rate
   };
   /// The representative preference of the header comment: true when `a` is the better candidate.
   bool preferred(const Candidate& a, const Candidate& b) const;

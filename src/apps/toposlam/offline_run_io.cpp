@@ -111,12 +111,14 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
   given.emplace_back(command.add_option("--cut", options.cut,
                                         "Segmentation: where a place ends: window-split (best split of the valley's "
                                         "window) or valley-frame")
-                         ->capture_default_str(),
+                         ->capture_default_str()
+                         ->check(CLI::IsMember({"window-split", "valley-frame"})),
                      kCut);
   given.emplace_back(command.add_option("--representative", options.representative,
                                         "Segmentation: a place's representative: window-degree (the thesis) or "
                                         "place-medoid (the sampled frame most like the place's others)")
-                         ->capture_default_str(),
+                         ->capture_default_str()
+                         ->check(CLI::IsMember({"window-degree", "place-medoid"})),
                      kRepresentative);
   given.emplace_back(command.add_option("--representative-interval-s", c.representative_interval_s,
                                         "Segmentation (place-medoid): sample the place's frames at most this often")

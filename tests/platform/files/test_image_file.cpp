@@ -10,6 +10,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "temp_folder.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "toposlam/io/source_factory.hpp"
@@ -21,18 +22,7 @@ namespace {
 
 const std::string kSamples = std::string(TOPOSLAM_SAMPLES_DIR) + "/samples";
 
-struct TempFolder {
-  fs::path path;
-  explicit TempFolder(const std::string& name)
-      : path(fs::temp_directory_path() / ("toposlam-image-" + name + "-" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
+using test::TempFolder;
 
 std::vector<unsigned char> readBytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

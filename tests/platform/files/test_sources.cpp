@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "temp_folder.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/sim_source.hpp"
 #include "toposlam/io/source_factory.hpp"
@@ -22,19 +23,7 @@ namespace {
 
 const std::string kSamples = std::string(TOPOSLAM_SAMPLES_DIR) + "/samples";
 
-/// A fresh temporary folder, removed when the test ends.
-struct TempFolder {
-  fs::path path;
-  explicit TempFolder(const std::string& name)
-      : path(fs::temp_directory_path() / ("toposlam-io-" + name + "-" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
+using test::TempFolder;
 
 std::vector<char> readBytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
