@@ -32,6 +32,7 @@
 #include "toposlam/io/recording_frame_source.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
+#include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 #include "toposlam/platform/lcm_transport.hpp"

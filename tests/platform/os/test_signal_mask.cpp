@@ -23,7 +23,9 @@ bool blockedHere(int signal) {
 
 }  // namespace
 
-SCENARIO("GIVEN SIGUSR2 blocked WHEN it is raised THEN it waits pending, and threads started afterwards block it too") {
+SCENARIO(
+    "GIVEN SIGUSR2 blocked WHEN it is raised THEN it waits pending, and threads started afterwards block it "
+    "too") {
   REQUIRE(blockSignals({SIGUSR2}) == 0);
   CHECK(blockedHere(SIGUSR2));
   bool blocked_in_thread = false;
