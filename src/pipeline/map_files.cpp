@@ -2,11 +2,13 @@
 // topology (map_store.hpp), every system call from platform/os.
 #include "toposlam/pipeline/map_files.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
 #include <sstream>
 #include <system_error>
+#include <vector>
 
 #include "toposlam/platform/file_system.hpp"
 
@@ -21,7 +23,7 @@ std::filesystem::path folderOf(const std::filesystem::path& path) {
   return path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
 }
 
-/// Opens a regular file for reading; throws MapStoreError naming it.
+/// Throws MapStoreError naming `path` when `file` did not open as a regular file.
 void requireOpen(const ReadableFile& file, const std::filesystem::path& path) {
   if (file.status() == ReadableFile::Status::cannot_open)
     throw MapStoreError("cannot open map " + path.string() + ": " + errnoText(file.error()));
