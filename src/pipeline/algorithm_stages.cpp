@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace toposlam {

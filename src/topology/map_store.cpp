@@ -1,18 +1,9 @@
-// MapStore: framing (magic, version, size, FNV-1a checksum), atomic file replacement, recovery from a
-// damaged file, and the lock of map.tsm.
+// MapStore's format: framing (magic, version, size, checksum), the payload, the settings, and the names
+// of the files kept beside a map. No I/O here: the file functions are in src/pipeline/map_files.cpp.
 #include "toposlam/topology/map_store.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
-#include <cstdlib>
 #include <cstring>
-#include <ctime>
-#include <fstream>
 #include <istream>
 #include <sstream>
 #include <streambuf>
@@ -27,28 +18,8 @@ namespace toposlam {
 namespace {
 
 constexpr char kMagic[8] = {'T', 'S', 'L', 'M', 'A', 'P', '\r', '\n'};
-constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8;
-
-std::string errnoText(int error) { return std::strerror(error); }
-
-/// Closes the descriptor and removes the temporary file unless released.
-struct TempFile {
-  std::string path;
-  int fd = -1;
-  bool keep = false;
-  ~TempFile() {
-    if (fd >= 0) ::close(fd);
-    if (!keep && !path.empty()) ::unlink(path.c_str());
-  }
-};
-
-/// Closes a descriptor on scope exit.
-struct Fd {
-  int fd = -1;
-  ~Fd() {
-    if (fd >= 0) ::close(fd);
-  }
-};
+constexpr std::size_t kHeaderSize = kMapHeaderSize;
+constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ULL;
 
 /// An istream over bytes it does not own (no copy of a large filter state).
 class ViewBuffer : public std::streambuf {
@@ -58,45 +29,6 @@ class ViewBuffer : public std::streambuf {
     setg(begin, begin, begin + data.size());
   }
 };
-
-/// Reads exactly `size` bytes at the current offset; false on a short read or an error (errno set).
-bool readFully(int fd, char* out, std::size_t size) {
-  std::size_t done = 0;
-  while (done < size) {
-    const ssize_t n = ::read(fd, out + done, size - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      if (n == 0) errno = EIO;  // the file shrank under us
-      return false;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-/// Opens a regular file for reading and returns its size; throws MapStoreError naming it.
-int openRegular(const std::filesystem::path& path, std::uint64_t& size) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw MapStoreError("cannot open map " + path.string() + ": " + std::strerror(errno));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw MapStoreError("cannot read map " + path.string() + ": not a regular file");
-  }
-  size = static_cast<std::uint64_t>(st.st_size);
-  return fd;
-}
-
-std::string sizeText(std::uint64_t bytes) {
-  std::ostringstream out;
-  if (bytes >= (1ull << 20)) {
-    out.precision(1);
-    out << std::fixed << static_cast<double>(bytes) / (1 << 20) << " MB";
-  } else {
-    out << bytes << " bytes";
-  }
-  return out.str();
-}
 
 std::string settingsText(const MapSettings& settings) {
   std::string text;
@@ -119,20 +51,7 @@ MapSettings parseSettings(std::string_view text, const std::string& name) {
   return settings;
 }
 
-/// "20240131T120501" in UTC.
-std::string timestampNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y%m%dT%H%M%S", &utc);
-  return text;
-}
-
 }  // namespace
-
-long MapFileOps::write(int fd, const void* data, std::size_t size) const { return ::write(fd, data, size); }
-int MapFileOps::fsync(int fd) const { return ::fsync(fd); }
 
 std::uint64_t fnv1a64(std::string_view data) {
   std::uint64_t hash = 0xcbf29ce484222325ULL;
@@ -145,40 +64,36 @@ std::uint64_t fnv1a64(std::string_view data) {
 
 namespace {
 
-/// The checksum of one map format version, fed piece by piece (a large map is verified streamed).
-class PayloadChecksum {
- public:
-  explicit PayloadChecksum(std::uint32_t version) : crc_(version >= 3) {}
-  void add(const char* data, std::size_t size) {
-    if (crc_) {
-      // zlib takes at most a uInt per call.
-      while (size > 0) {
-        const auto n = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
-        crc32_ = ::crc32(crc32_, reinterpret_cast<const Bytef*>(data), n);
-        data += n;
-        size -= n;
-      }
-      return;
-    }
-    for (std::size_t i = 0; i < size; ++i) {
-      fnv_ ^= static_cast<std::uint8_t>(data[i]);
-      fnv_ *= 0x100000001b3ULL;
-    }
+/// zlib's CRC-32 of `data` continued from `crc`.
+std::uint64_t addCrc32(std::uint64_t crc, const char* data, std::size_t size) {
+  uLong value = static_cast<uLong>(crc);
+  // zlib takes at most a uInt per call.
+  while (size > 0) {
+    const auto n = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
+    value = ::crc32(value, reinterpret_cast<const Bytef*>(data), n);
+    data += n;
+    size -= n;
   }
-  std::uint64_t value() const { return crc_ ? static_cast<std::uint64_t>(crc32_) : fnv_; }
+  return static_cast<std::uint64_t>(value);
+}
 
- private:
-  bool crc_;
-  uLong crc32_ = ::crc32(0L, Z_NULL, 0);
-  std::uint64_t fnv_ = 0xcbf29ce484222325ULL;
-};
+/// FNV-1a 64 of `data` continued from `hash`.
+std::uint64_t addFnv1a64(std::uint64_t hash, const char* data, std::size_t size) {
+  for (std::size_t i = 0; i < size; ++i) {
+    hash ^= static_cast<std::uint8_t>(data[i]);
+    hash *= 0x100000001b3ULL;
+  }
+  return hash;
+}
+
+/// The checksum a map file of format `version` carries: CRC-32 from version 3, FNV-1a 64 before.
+bool usesCrc32(std::uint32_t version) { return version >= 3; }
 
 }  // namespace
 
 std::uint64_t mapPayloadChecksum(std::uint32_t version, std::string_view payload) {
-  PayloadChecksum checksum(version);
-  checksum.add(payload.data(), payload.size());
-  return checksum.value();
+  return usesCrc32(version) ? addCrc32(::crc32(0L, Z_NULL, 0), payload.data(), payload.size())
+                            : addFnv1a64(kFnvOffset, payload.data(), payload.size());
 }
 
 bool settingDiffers(const MapSettings& recorded, const MapSettings& current, const std::string& key) {
@@ -215,7 +130,10 @@ std::string MapStore::encode(const FrozenTopologyState& frozen, std::string_view
   return out;
 }
 
-std::string_view MapStore::verifiedPayload(std::string_view file, const std::string& name) {
+namespace {
+
+/// The payload of a file image whose framing verifies. Throws MapStoreError saying what is wrong.
+std::string_view verifiedPayload(std::string_view file, const std::string& name) {
   if (file.size() < 8 || std::memcmp(file.data(), kMagic, 8) != 0) {
     throw MapStoreError(name + ": not a toposlam map file (bad magic)");
   }
@@ -242,8 +160,9 @@ std::string_view MapStore::verifiedPayload(std::string_view file, const std::str
   return payload;
 }
 
-LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& similarity,
-                           const std::string& name) {
+}  // namespace
+
+LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& similarity, const std::string& name) {
   const std::string_view payload = verifiedPayload(file, name);
   const std::uint32_t version = topology_detail::BinaryReader(file.substr(8, 4)).u32("version");
   try {
@@ -264,196 +183,29 @@ LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& simil
   }
 }
 
-bool MapStore::fileVerifies(const std::filesystem::path& path) {
-  // Streamed: a large map is checked in 1 MB pieces, never held in memory here.
-  std::uint64_t file_size = 0;
-  Fd fd;
-  try {
-    fd.fd = openRegular(path, file_size);
-  } catch (const MapStoreError&) {
-    return false;
-  }
-  if (file_size < kHeaderSize) return false;
-  std::string header(kHeaderSize, '\0');
-  if (!readFully(fd.fd, header.data(), header.size())) return false;
+bool MapFramingCheck::start(std::string_view header, std::uint64_t file_size) {
+  if (header.size() < kHeaderSize || file_size < kHeaderSize) return false;
   if (std::memcmp(header.data(), kMagic, 8) != 0) return false;
-  topology_detail::BinaryReader fields(std::string_view(header).substr(8));
-  const std::uint32_t version = fields.u32("version");
+  topology_detail::BinaryReader fields(header.substr(8, kHeaderSize - 8));
+  version_ = fields.u32("version");
   fields.u32("reserved");
-  const std::uint64_t size = fields.u64("size");
-  const std::uint64_t checksum = fields.u64("checksum");
-  if (version == 0 || version > kMapFormatVersion || file_size - kHeaderSize != size) return false;
-  PayloadChecksum hash(version);
-  std::vector<char> chunk(1 << 20);
-  for (std::uint64_t left = size; left > 0;) {
-    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(left, chunk.size()));
-    if (!readFully(fd.fd, chunk.data(), n)) return false;
-    hash.add(chunk.data(), n);
-    left -= n;
-  }
-  return hash.value() == checksum;
+  payload_size_ = fields.u64("size");
+  expected_ = fields.u64("checksum");
+  if (version_ == 0 || version_ > kMapFormatVersion || file_size - kHeaderSize != payload_size_) return false;
+  crc_ = usesCrc32(version_);
+  crc32_ = ::crc32(0L, Z_NULL, 0);
+  fnv_ = kFnvOffset;
+  return true;
 }
 
-void MapStore::writeAtomically(const std::filesystem::path& path, std::string_view bytes,
-                               const MapFileOps& ops) {
-  const std::filesystem::path directory =
-      path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  TempFile temp;
-  {
-    std::string name = ".";
-    name += path.filename().string();
-    name += ".XXXXXX";
-    const std::string pattern = (directory / name).string();
-    std::vector<char> buffer(pattern.begin(), pattern.end());
-    buffer.push_back('\0');
-    temp.fd = ::mkstemp(buffer.data());
-    if (temp.fd < 0) {
-      throw MapStoreError("cannot create a temporary file in " + directory.string() + ": " +
-                          errnoText(errno));
-    }
-    temp.path = buffer.data();
-    ::fchmod(temp.fd, 0644);  // mkstemp creates 0600; a map is not secret (best effort)
-  }
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const long n = ops.write(temp.fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = n < 0 ? errno : ENOSPC;
-      throw MapStoreError("cannot write map " + path.string() + ": " + errnoText(error) +
-                          " (the previous map file is unchanged)");
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  if (ops.fsync(temp.fd) != 0) {
-    throw MapStoreError("cannot flush map " + path.string() + " to disk: " + errnoText(errno) +
-                        " (the previous map file is unchanged)");
-  }
-  const int fd = temp.fd;
-  temp.fd = -1;
-  if (::close(fd) != 0) {
-    throw MapStoreError("cannot close map " + path.string() + ": " + errnoText(errno) +
-                        " (the previous map file is unchanged)");
-  }
-  // Keep the file being replaced as <path>.prev (best effort: a hard link, no copy), but only when its
-  // framing verifies: a damaged file must not push the last good map out of <path>.prev.
-  if (fileVerifies(path)) {
-    const std::string previous = path.string() + ".prev";
-    const std::string previous_temp = temp.path + ".prev";
-    if (::link(path.c_str(), previous_temp.c_str()) == 0) {
-      if (::rename(previous_temp.c_str(), previous.c_str()) != 0) ::unlink(previous_temp.c_str());
-    }
-  }
-  if (::rename(temp.path.c_str(), path.c_str()) != 0) {
-    throw MapStoreError("cannot replace map " + path.string() + ": " + errnoText(errno) +
-                        " (the previous map file is unchanged)");
-  }
-  temp.keep = true;
-  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    const int result = ops.fsync(dir_fd);
-    const int error = errno;
-    ::close(dir_fd);
-    if (result != 0 && error != EINVAL) {
-      throw MapStoreError("map " + path.string() +
-                          " written but its directory could not be flushed: " + errnoText(error));
-    }
-  }
+void MapFramingCheck::add(const char* data, std::size_t size) {
+  if (crc_)
+    crc32_ = addCrc32(crc32_, data, size);
+  else
+    fnv_ = addFnv1a64(fnv_, data, size);
 }
 
-void MapStore::save(const std::filesystem::path& path, const TopologyParticleFilter& filter,
-                    std::string_view application_data, const MapFileOps& ops) {
-  writeAtomically(path, encode(filter, application_data), ops);
-}
-
-void MapStore::save(const std::filesystem::path& path, const TopologyParticleFilter& filter,
-                    std::string_view application_data, const MapSettings& settings, const MapFileOps& ops) {
-  writeAtomically(path, encode(filter, application_data, settings), ops);
-}
-
-LoadedMap MapStore::load(const std::filesystem::path& path, const SimilarityMeasure& similarity,
-                         std::uint64_t max_bytes) {
-  std::uint64_t size = 0;
-  Fd fd;
-  fd.fd = openRegular(path, size);
-  std::string hint;
-  if (std::filesystem::exists(path.string() + ".prev"))
-    hint = " (the previous map is kept in " + path.string() + ".prev)";
-  if (size > max_bytes) {
-    throw MapTooLargeError("map " + path.string() + " is " + sizeText(size) + ", more than the cap of " +
-                           sizeText(max_bytes) + " (map.max_mb); refused unread" + hint);
-  }
-  std::string content(static_cast<std::size_t>(size), '\0');  // read once, into this one buffer
-  if (!readFully(fd.fd, content.data(), content.size()))
-    throw MapStoreError("cannot read map " + path.string() + ": " + std::strerror(errno));
-  try {
-    return decode(content, similarity, path.string());
-  } catch (const MapStoreError& e) {
-    throw MapStoreError(e.what() + hint);
-  }
-}
-
-std::string MapStore::moveAside(const std::filesystem::path& file) {
-  const std::string stem = file.string() + ".damaged-" + timestampNow();
-  std::string aside = stem;
-  // link() never replaces an existing name, so an earlier .damaged file is never overwritten.
-  int result = -1;
-  int error = 0;
-  for (int n = 1; n <= 100; ++n) {
-    result = ::link(file.c_str(), aside.c_str());
-    error = errno;
-    if (result == 0 || error != EEXIST) break;
-    aside = stem + "-" + std::to_string(n);
-  }
-  if (result != 0) {
-    return "could not move it aside (" + std::string(std::strerror(error)) + "); it is left where it is";
-  }
-  if (::unlink(file.c_str()) != 0) {
-    const int unlink_error = errno;
-    ::unlink(aside.c_str());
-    return "could not move it aside (" + std::string(std::strerror(unlink_error)) + "); it is left where it is";
-  }
-  // Keep the newest kMaxDamagedFiles of this file (names sort by their timestamps).
-  std::vector<std::filesystem::path> damaged;
-  std::error_code ec;
-  const std::filesystem::path directory =
-      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-  const std::string prefix = file.filename().string() + ".damaged-";
-  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind(prefix, 0) == 0) damaged.push_back(entry.path());
-  }
-  std::sort(damaged.begin(), damaged.end());  // oldest first: "<ts>" < "<ts>-1" < "<later ts>"
-  std::string pruned;
-  while (damaged.size() > static_cast<std::size_t>(kMaxDamagedFiles)) {
-    std::filesystem::remove(damaged.front(), ec);
-    pruned += (pruned.empty() ? "" : ", ") + damaged.front().filename().string();
-    damaged.erase(damaged.begin());
-  }
-  std::string text = "moved it to " + aside;
-  if (!pruned.empty()) text += " (removed the oldest damaged copies: " + pruned + ")";
-  return text;
-}
-
-RecoveredMap MapStore::recover(const std::filesystem::path& path, const SimilarityMeasure& similarity,
-                               std::uint64_t max_bytes) {
-  RecoveredMap result;
-  const std::filesystem::path candidates[] = {path, std::filesystem::path(path.string() + ".prev")};
-  for (const std::filesystem::path& candidate : candidates) {
-    std::error_code ec;
-    if (!std::filesystem::exists(candidate, ec)) continue;
-    try {
-      result.map = load(candidate, similarity, max_bytes);
-      result.loaded_from = candidate;
-      return result;
-    } catch (const MapTooLargeError&) {
-      throw;  // not damage: nothing is moved, the caller refuses to start (a bigger cap, or another map)
-    } catch (const MapStoreError& e) {
-      result.problems.push_back(std::string(e.what()) + "; " + moveAside(candidate));
-    }
-  }
-  return result;
-}
+bool MapFramingCheck::verified() const { return (crc_ ? crc32_ : fnv_) == expected_; }
 
 std::string MapStore::checkSettings(const MapSettings& recorded, const MapSettings& current,
                                     const std::string& name) {
@@ -469,81 +221,50 @@ std::string MapStore::checkSettings(const MapSettings& recorded, const MapSettin
          ": continue it with the same settings, or start a new map";
 }
 
-int MapStore::removeOrphanedTemporaries(const std::filesystem::path& path) {
-  const std::filesystem::path directory =
-      path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  const std::string prefix = "." + path.filename().string() + ".";
-  int removed = 0;
-  std::error_code ec;
-  std::vector<std::filesystem::path> orphans;
-  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
-    std::string rest = entry.path().filename().string();
-    if (rest.rfind(prefix, 0) != 0) continue;
-    rest = rest.substr(prefix.size());
-    if (rest.size() == 6 + 5 && rest.compare(6, 5, ".prev") == 0) rest.resize(6);
-    // mkstemp's six characters: letters and digits.
-    if (rest.size() == 6 && std::all_of(rest.begin(), rest.end(), [](char c) {
-          return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
-        }))
-      orphans.push_back(entry.path());
-  }
-  for (const auto& orphan : orphans)
-    if (std::filesystem::remove(orphan, ec)) ++removed;
-  return removed;
-}
-
 // ------------------------------------------------------------------------------------------------------------
+// The names of the files kept beside a map.
 
-MapLock MapLock::acquire(const std::filesystem::path& map_path) {
-  std::filesystem::path locked = map_path.string() + ".lock";
-  int fd = ::open(locked.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0 && (errno == EROFS || errno == EACCES || errno == EPERM)) {
-    // A read-only state directory: lock the directory itself (saves will fail there anyway, but a second
-    // daemon is still refused).
-    locked = map_path.has_parent_path() ? map_path.parent_path() : std::filesystem::path(".");
-    fd = ::open(locked.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  }
-  if (fd < 0) throw MapStoreError("cannot create the lock file " + locked.string() + ": " + std::strerror(errno));
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    const int error = errno;
-    std::string holder;
-    char text[32] = {};
-    if (::pread(fd, text, sizeof text - 1, 0) > 0) {
-      const long pid = std::strtol(text, nullptr, 10);
-      if (pid > 0) holder = " (process " + std::to_string(pid) + ")";
-    }
-    ::close(fd);
-    if (error == EWOULDBLOCK) {
-      throw MapStoreError("the map " + map_path.string() + " is in use by another toposlam process" + holder +
-                          ": it holds " + locked.string() + "; stop it or use another map path");
-    }
-    throw MapStoreError("cannot lock " + locked.string() + ": " + std::strerror(error));
-  }
-  // Record our process id for the message a second process prints (best effort).
-  struct stat st {};
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
-    const std::string pid = std::to_string(::getpid()) + "\n";
-    if (::ftruncate(fd, 0) == 0 && ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
-      // ignored: the lock itself is what matters
-    }
-  }
-  return MapLock(fd, locked);
+std::filesystem::path MapStore::previousPath(const std::filesystem::path& path) { return path.string() + ".prev"; }
+
+std::string MapStore::previousTemporaryPath(const std::string& temporary_path) { return temporary_path + ".prev"; }
+
+std::vector<std::filesystem::path> MapStore::recoveryCandidates(const std::filesystem::path& path) {
+  return {path, previousPath(path)};
 }
 
-MapLock::MapLock(MapLock&& other) noexcept : fd_(other.fd_), locked_(std::move(other.locked_)) { other.fd_ = -1; }
-
-MapLock& MapLock::operator=(MapLock&& other) noexcept {
-  if (this != &other) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = other.fd_;
-    locked_ = std::move(other.locked_);
-    other.fd_ = -1;
-  }
-  return *this;
+bool MapStore::isTemporaryOf(const std::filesystem::path& path, const std::string& file_name) {
+  std::string prefix = ".";  // built piecewise: GCC 12 warns falsely (-Wrestrict) on "." + string
+  prefix += path.filename().string();
+  prefix += kTemporaryInfix;
+  if (file_name.rfind(prefix, 0) != 0) return false;
+  std::string rest = file_name.substr(prefix.size());
+  if (rest.size() == 6 + 5 && rest.compare(6, 5, ".prev") == 0) rest.resize(6);
+  // mkstemp's six characters: letters and digits.
+  return rest.size() == 6 && std::all_of(rest.begin(), rest.end(), [](char c) {
+           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+         });
 }
 
-MapLock::~MapLock() {
-  if (fd_ >= 0) ::close(fd_);  // closing the last descriptor releases the flock
+std::filesystem::path MapStore::damagedPath(const std::filesystem::path& file, const std::string& timestamp,
+                                            int attempt) {
+  std::string name = file.string() + ".damaged-" + timestamp;
+  if (attempt >= 1) {
+    name += '-';  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "-" + string
+    name += std::to_string(attempt);
+  }
+  return name;
+}
+
+bool MapStore::isDamagedCopyOf(const std::filesystem::path& file, const std::string& file_name) {
+  return file_name.rfind(file.filename().string() + ".damaged-", 0) == 0;
+}
+
+std::vector<std::filesystem::path> MapStore::damagedCopiesToRemove(std::vector<std::filesystem::path> copies) {
+  std::sort(copies.begin(), copies.end());  // oldest first: "<ts>" < "<ts>-1" < "<later ts>"
+  const std::size_t keep = static_cast<std::size_t>(kMaxDamagedFiles);
+  if (copies.size() <= keep) return {};
+  copies.resize(copies.size() - keep);
+  return copies;
 }
 
 }  // namespace toposlam

@@ -13,22 +13,26 @@
 // be continued by a run (the keypoint backend: ORB descriptors mean nothing to a SIFT run; the source,
 // kMapSourceKey: a simulated office is no part of the robot's real map); checkSettings() compares them.
 //
-// Writing is atomic: a temporary file in the same directory is written, fsync'ed, renamed over the
-// target, and the directory is fsync'ed. The file it replaces is kept as "<path>.prev" (a hard link),
-// but only when that file verifies (framing and checksum), so saving over a damaged map never pushes
-// the last good one out of .prev.
-// Any failure (e.g. a full disk) throws MapStoreError and leaves the old file untouched.
+// This header is the format and the policies, with no I/O (an algorithm touches no file): encode()
+// and decode() turn a filter into a file image and back; MapFramingCheck verifies a file's framing piece
+// by piece; the names below say which files the store keeps beside a map. The file functions of the same
+// name space (MapStore::save, load, recover, writeAtomically, removeOrphanedTemporaries, fileVerifies)
+// and MapLock carry these policies out through platform/os: toposlam/pipeline/map_files.hpp.
+//
+// The policies:
+// - Writing is atomic (a temporary file ".<name>.XXXXXX" in the same directory, fsync'ed, renamed over
+//   the target, the directory fsync'ed). The file it replaces is kept as "<path>.prev" (a hard link, made
+//   through ".<name>.XXXXXX.prev"), but only when that file verifies (framing and checksum), so saving
+//   over a damaged map never pushes the last good one out of .prev.
+// - Recovery tries the map, then its .prev (recoveryCandidates); a file that does not load is moved
+//   aside under a timestamped name (<path>.damaged-YYYYmmddTHHMMSS[-N]; never over an earlier one) and
+//   the oldest damaged copies beyond kMaxDamagedFiles are removed.
+// - The temporaries a kill -9 during a save leaves behind are recognised by their names
+//   (isTemporaryOf) and removed at the next start, under the map's lock.
 // Loading refuses a wrong magic, a newer version, a truncated or damaged file with a MapStoreError that
-// says which; the file on disk is never modified by loading. A file larger than the size cap is refused
-// from its size before anything is read; a file is read once, into one buffer.
+// says which.
 //
-// Recovery (recover(), for the daemon's start): a map that does not load is moved aside under a
-// timestamped name (<path>.damaged-YYYYmmddTHHMMSS[-N]; never over an earlier one; the oldest beyond
-// kMaxDamagedFiles are removed) and the newest file that loads, <path>.prev, is used instead.
-// MapLock (flock on <path>.lock) keeps a second writer off a map; removeOrphanedTemporaries() deletes
-// the temporary files a kill -9 during a save leaves behind (call it while holding the lock).
-//
-// Thread-safety: the functions are reentrant; do not save to the same path from two threads.
+// Thread-safety: the functions are reentrant; MapFramingCheck is one reader's.
 #pragma once
 
 #include <cstddef>
@@ -82,16 +86,6 @@ class MapTooLargeError : public MapStoreError {
   using MapStoreError::MapStoreError;
 };
 
-/// The system calls MapStore writes through; tests inject failures (a full disk) by overriding them.
-class MapFileOps {
- public:
-  virtual ~MapFileOps() = default;
-  /// Like ::write: bytes written, or -1 with errno set.
-  virtual long write(int fd, const void* data, std::size_t size) const;
-  /// Like ::fsync: 0, or -1 with errno set.
-  virtual int fsync(int fd) const;
-};
-
 /// FNV-1a, 64 bit.
 std::uint64_t fnv1a64(std::string_view data);
 /// The payload checksum a map file of format `version` carries (CRC-32 from 3, FNV-1a 64 before).
@@ -103,85 +97,70 @@ struct LoadedMap {
   MapSettings settings;  ///< empty for a version-1 file (recorded nothing)
 };
 
-/// What MapStore::recover found.
-struct RecoveredMap {
-  std::optional<LoadedMap> map;         ///< empty: no file loaded (start a new map)
-  std::filesystem::path loaded_from;    ///< the file `map` came from (the map or its .prev)
-  std::vector<std::string> problems;    ///< one line per file that did not load and what became of it
-};
+/// The fixed header in front of the payload: magic, version, reserved, payload size, checksum (bytes).
+inline constexpr std::size_t kMapHeaderSize = 8 + 4 + 4 + 8 + 8;
 
-/// An exclusive advisory lock (flock) on a map, held while the object lives. Movable.
-class MapLock {
+/// Checks a map file's framing (magic, version, size, checksum) from its bytes fed in order, without
+/// holding the file: start() with the first kMapHeaderSize bytes, add() the payload in pieces, then
+/// verified(). The payload itself is not parsed.
+class MapFramingCheck {
  public:
-  /// Locks `map_path` through "<map_path>.lock" (created if needed; when the directory is read-only,
-  /// the directory itself is locked). Throws MapStoreError naming the file when another process holds
-  /// it (with that process' id when known).
-  static MapLock acquire(const std::filesystem::path& map_path);
-  MapLock(MapLock&& other) noexcept;
-  MapLock& operator=(MapLock&& other) noexcept;
-  MapLock(const MapLock&) = delete;
-  MapLock& operator=(const MapLock&) = delete;
-  ~MapLock();
-  /// The file (or directory) locked.
-  const std::filesystem::path& lockedPath() const { return locked_; }
+  /// False when `header` is not the header of a map this build reads whose payload makes the file
+  /// exactly `file_size` bytes long (then there is nothing to add).
+  bool start(std::string_view header, std::uint64_t file_size);
+  /// The payload's size in bytes, after start() returned true.
+  std::uint64_t payloadSize() const { return payload_size_; }
+  void add(const char* data, std::size_t size);
+  /// True when the payload added has the checksum the header records.
+  bool verified() const;
 
  private:
-  MapLock(int fd, std::filesystem::path locked) : fd_(fd), locked_(std::move(locked)) {}
-  int fd_ = -1;
-  std::filesystem::path locked_;
+  std::uint32_t version_ = 0;
+  std::uint64_t payload_size_ = 0;
+  std::uint64_t expected_ = 0;
+  bool crc_ = false;
+  std::uint64_t crc32_ = 0;
+  std::uint64_t fnv_ = 0;
 };
 
-class MapStore {
- public:
-  /// The whole file image of `filter` (+ application data). Throws std::logic_error during a step.
-  static std::string encode(const TopologyParticleFilter& filter, std::string_view application_data = {},
-                            const MapSettings& settings = {});
-  /// The file image of a frozen state (TopologyParticleFilter::freeze()): what encode(filter) gave when
-  /// it was frozen. Any thread (see FrozenTopologyState).
-  static std::string encode(const FrozenTopologyState& state, std::string_view application_data = {},
-                            const MapSettings& settings = {});
-  /// Parses a file image; `name` is used in error messages. Throws MapStoreError.
-  static LoadedMap decode(std::string_view file, const SimilarityMeasure& similarity,
-                          const std::string& name = "map");
+/// The format, and the names of the files kept beside a map (see the policies above). The file functions
+/// of this name space are in toposlam/pipeline/map_files.hpp.
+namespace MapStore {
 
-  /// Atomically replaces `path` (see above). Throws MapStoreError.
-  static void save(const std::filesystem::path& path, const TopologyParticleFilter& filter,
-                   std::string_view application_data = {}, const MapFileOps& ops = MapFileOps{});
-  static void save(const std::filesystem::path& path, const TopologyParticleFilter& filter,
-                   std::string_view application_data, const MapSettings& settings,
-                   const MapFileOps& ops = MapFileOps{});
-  /// Writes raw bytes atomically (used by save; exposed for tests). Throws MapStoreError.
-  static void writeAtomically(const std::filesystem::path& path, std::string_view bytes,
-                              const MapFileOps& ops = MapFileOps{});
-  /// Throws MapStoreError (missing, unreadable, not a map, newer version, truncated, damaged).
-  /// Files larger than `max_bytes` are refused from their size, unread.
-  static LoadedMap load(const std::filesystem::path& path, const SimilarityMeasure& similarity,
-                        std::uint64_t max_bytes = kDefaultMaxMapBytes);
+/// The whole file image of `filter` (+ application data). Throws std::logic_error during a step.
+std::string encode(const TopologyParticleFilter& filter, std::string_view application_data = {},
+                   const MapSettings& settings = {});
+/// The file image of a frozen state (TopologyParticleFilter::freeze()): what encode(filter) gave when
+/// it was frozen. Any thread (see FrozenTopologyState).
+std::string encode(const FrozenTopologyState& state, std::string_view application_data = {},
+                   const MapSettings& settings = {});
+/// Parses a file image; `name` is used in error messages. Throws MapStoreError.
+LoadedMap decode(std::string_view file, const SimilarityMeasure& similarity, const std::string& name = "map");
 
-  /// The newest good map at `path` (see "Recovery" above): `path` if it loads, else `path`.prev; every
-  /// file that does not load is moved aside (when the directory allows). Nothing there: an empty result.
-  /// Throws MapTooLargeError (and moves nothing) when a file is over the size cap.
-  static RecoveredMap recover(const std::filesystem::path& path, const SimilarityMeasure& similarity,
-                              std::uint64_t max_bytes = kDefaultMaxMapBytes);
+/// Empty when a map recorded with `recorded` settings can be continued by a run with `current` ones
+/// (keys present in both agree; a version-1 map recorded none), else a message naming both values.
+std::string checkSettings(const MapSettings& recorded, const MapSettings& current, const std::string& name);
 
-  /// Empty when a map recorded with `recorded` settings can be continued by a run with `current` ones
-  /// (keys present in both agree; a version-1 map recorded none), else a message naming both values.
-  static std::string checkSettings(const MapSettings& recorded, const MapSettings& current,
-                                   const std::string& name);
+/// What a save writes its temporary file under: "." + the map's name + this + six characters.
+inline constexpr const char* kTemporaryInfix = ".";
+/// "<path>.prev": the map a save replaced, when it verified.
+std::filesystem::path previousPath(const std::filesystem::path& path);
+/// The name the replaced map is linked to before it is renamed to previousPath(): the save's own
+/// temporary file's name + ".prev" (so that a kill -9 leaves only names isTemporaryOf recognises).
+std::string previousTemporaryPath(const std::string& temporary_path);
+/// The files recovery tries, newest first: the map, then its .prev.
+std::vector<std::filesystem::path> recoveryCandidates(const std::filesystem::path& path);
+/// True when `file_name` (a bare name in the map's directory) is the temporary file of a save of `path`
+/// (".<name>.XXXXXX" or ".<name>.XXXXXX.prev", six letters or digits).
+bool isTemporaryOf(const std::filesystem::path& path, const std::string& file_name);
+/// Where a damaged `file` is moved: "<file>.damaged-<timestamp>", or "...-<attempt>" for attempt >= 1
+/// (when the earlier names are taken).
+std::filesystem::path damagedPath(const std::filesystem::path& file, const std::string& timestamp, int attempt);
+/// True when `file_name` (a bare name in the directory of `file`) is a damaged copy of `file`.
+bool isDamagedCopyOf(const std::filesystem::path& file, const std::string& file_name);
+/// Of the damaged copies of one file, those to remove (oldest first) so that kMaxDamagedFiles remain.
+std::vector<std::filesystem::path> damagedCopiesToRemove(std::vector<std::filesystem::path> copies);
 
-  /// Removes the temporary files of interrupted saves of `path` (".<name>.XXXXXX[.prev]" beside it).
-  /// Returns how many were removed. Call it while holding the map's MapLock.
-  static int removeOrphanedTemporaries(const std::filesystem::path& path);
-
-  /// True when `path` is a readable map file whose framing verifies (magic, version, size, checksum);
-  /// the payload is not parsed. writeAtomically keeps a replaced file as .prev only when this holds.
-  static bool fileVerifies(const std::filesystem::path& path);
-
- private:
-  /// The payload of a file image whose framing verifies. Throws MapStoreError saying what is wrong.
-  static std::string_view verifiedPayload(std::string_view file, const std::string& name);
-  /// Moves a file that did not load aside (see "Recovery"); returns what happened, for the log.
-  static std::string moveAside(const std::filesystem::path& file);
-};
+}  // namespace MapStore
 
 }  // namespace toposlam

@@ -12,7 +12,7 @@
 
 #include "commands.hpp"
 #include "eval_cli_options.hpp"
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 #include "toposlam/eval/evaluation.hpp"
 
 namespace toposlam::cli {

@@ -10,7 +10,6 @@
 // `lcm.url: file://FILE?mode=w`), read with the pure LcmLogReader: the same lines, as fast as read; --hz
 // rates over the log's own time. `--run-folder DIR` also turns it into a run folder for `toposlam report`.
 // A corrupt or truncated log is an error naming the byte offset (after the messages before it).
-#include <pthread.h>
 #include <signal.h>
 
 #include <chrono>
@@ -21,6 +20,7 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "commands.hpp"
 #include "toposlam/config/config_path.hpp"
@@ -30,6 +30,7 @@
 #include "toposlam/platform/lcm_log.hpp"
 #include "toposlam/platform/lcm_log_run.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
+#include "toposlam/platform/signal_mask.hpp"
 
 namespace toposlam::cli {
 
@@ -38,20 +39,15 @@ namespace {
 volatile std::sig_atomic_t g_interrupted = 0;
 void onInterrupt(int) { g_interrupted = 1; }
 
-sigset_t stopSignals() {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  return set;
+/// The signals that stop `listen`.
+const std::vector<int>& stopSignals() {
+  static const std::vector<int> signals{SIGINT, SIGTERM};
+  return signals;
 }
 
 // LCM's udpm provider receives on a thread of its own; blocked there, a stop signal always reaches this
 // (the calling) thread, whose select() then returns EINTR.
-void blockStopSignals() {
-  const sigset_t set = stopSignals();
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
-}
+void blockStopSignals() { blockSignals(stopSignals()); }
 
 // sigaction without SA_RESTART: the handler only sets the flag, and the wait in select() returns EINTR
 // (which LcmSubscriber::handle treats as "look at the flag"), so the exit follows the signal at once.
@@ -62,8 +58,7 @@ void catchStopSignals() {
   action.sa_flags = 0;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
-  const sigset_t set = stopSignals();
-  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+  unblockSignals(stopSignals());
 }
 
 std::vector<std::string> splitChannels(const std::string& text) {

@@ -21,7 +21,7 @@
 #include <stdexcept>
 
 #include "commands.hpp"
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 #include "image_input.hpp"
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"

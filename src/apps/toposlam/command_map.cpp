@@ -39,6 +39,7 @@
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/segmentation/offline_mapper.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
+#include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"

@@ -24,7 +24,7 @@
 #include "image_input.hpp"
 #include "offline_run_io.hpp"
 #include "toposlam/core/json_writer.hpp"
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 #include "toposlam/core/svg_plot.hpp"
 #include "toposlam/eval/evaluation.hpp"
 #include "toposlam/eval/orb_baseline.hpp"

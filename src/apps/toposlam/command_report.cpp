@@ -21,7 +21,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 #include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"

@@ -16,7 +16,7 @@
 
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/frame_timeline.hpp"
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 

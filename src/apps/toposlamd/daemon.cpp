@@ -23,6 +23,7 @@
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
@@ -31,9 +32,11 @@
 #include "toposlam/io/recording_frame_source.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
+#include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
+#include "toposlam/platform/signal_mask.hpp"
 #include "toposlam/platform/systemd_notifier.hpp"
 #include "toposlam/topology/map_store.hpp"
 
@@ -49,11 +52,17 @@ bool isStopSignal(int signal) {
 }
 
 /// Every signal the main thread takes with sigtimedwait (stop and ignored ones).
+std::vector<int> handledSignalNumbers() {
+  std::vector<int> signals(std::begin(kStopSignals), std::end(kStopSignals));
+  signals.insert(signals.end(), std::begin(kIgnoredSignals), std::end(kIgnoredSignals));
+  return signals;
+}
+
+/// The same, as the set sigtimedwait takes.
 sigset_t handledSignals() {
   sigset_t set;
   sigemptyset(&set);
-  for (int s : kStopSignals) sigaddset(&set, s);
-  for (int s : kIgnoredSignals) sigaddset(&set, s);
+  for (int s : handledSignalNumbers()) sigaddset(&set, s);
   return set;
 }
 
@@ -240,7 +249,7 @@ std::string resolveMapPath(const std::string& path) {
 
 int runDaemon(const DaemonConfig& config) {
   const sigset_t signals = handledSignals();
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // before any thread exists: all inherit it
+  blockSignals(handledSignalNumbers());  // before any thread exists: all inherit it
   std::signal(SIGPIPE, SIG_IGN);                  // EPIPE instead of death on a closed log pipe
 
   SystemdNotifier notifier;

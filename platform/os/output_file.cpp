@@ -1,5 +1,5 @@
 // OutputFile (output_file.hpp): a checked, atomically renamed output file.
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

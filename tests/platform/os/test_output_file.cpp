@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "toposlam/core/output_file.hpp"
+#include "toposlam/platform/output_file.hpp"
 
 using namespace toposlam;
 namespace fs = std::filesystem;
