@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "test_files.hpp"
 #include "topology/fake_similarity.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/pipeline/map_files.hpp"
@@ -22,39 +23,19 @@
 
 using namespace toposlam;
 using toposlam::test::placeSimilarity;
+using toposlam::test::smallFilter;
 using toposlam::test::taggedFingerprint;
 
 namespace fs = std::filesystem;
+using toposlam::test::filesIn;
+using toposlam::test::readAll;
+using toposlam::test::TempFolder;
 
 namespace {
-
-fs::path freshDirectory(const std::string& name) {
-  const fs::path dir =
-      fs::path(TOPOSLAM_BINARY_DIR) / "test-output" / "topology" / (name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string readAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
 
 void writeAll(const fs::path& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << bytes;
-}
-
-std::unique_ptr<TopologyParticleFilter> smallFilter(const SimilarityMeasure& sim, int steps) {
-  TopologyFilterConfig c;
-  c.particles = 50;
-  c.seed = 3;
-  auto filter = std::make_unique<TopologyParticleFilter>(c, sim);
-  for (int k = 0; k < steps; ++k) filter->step(taggedFingerprint(k % 4));
-  return filter;
 }
 
 /// Fails every write after `budget` bytes with ENOSPC, like a full disk.
@@ -77,18 +58,13 @@ class FullDisk : public MapFileOps {
   mutable std::size_t written_ = 0;
 };
 
-std::size_t filesIn(const fs::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n;
-  return n;
-}
-
 }  // namespace
 
 TEST_CASE("GIVEN a saved map WHEN loaded THEN the filter and application data come back exactly",
           "[topology][map]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("roundtrip");
+  const TempFolder temp("roundtrip");
+  const fs::path& dir = temp.path;
   auto filter = smallFilter(sim, 10);
   MapStore::save(dir / "map.tsm", *filter, "places");
   LoadedMap loaded = MapStore::load(dir / "map.tsm", sim);
@@ -109,7 +85,8 @@ TEST_CASE("GIVEN a saved map WHEN loaded THEN the filter and application data co
 
 TEST_CASE("GIVEN damaged map files WHEN loaded THEN each is refused with a clear error", "[topology][map]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("damaged");
+  const TempFolder temp("damaged");
+  const fs::path& dir = temp.path;
   auto filter = smallFilter(sim, 8);
   const fs::path good = dir / "map.tsm";
   MapStore::save(good, *filter);
@@ -165,7 +142,8 @@ TEST_CASE("GIVEN damaged map files WHEN loaded THEN each is refused with a clear
 TEST_CASE("GIVEN a damaged map on disk WHEN a new map is saved over it THEN .prev keeps the last good map",
           "[topology][map]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("rotate");
+  const TempFolder temp("rotate");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 5);
   MapStore::save(path, *filter, "first");
@@ -195,7 +173,8 @@ TEST_CASE("GIVEN a damaged map on disk WHEN a new map is saved over it THEN .pre
 TEST_CASE("GIVEN a full disk WHEN a map is saved THEN a clear error is thrown and the old file is intact",
           "[topology][map]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("fulldisk");
+  const TempFolder temp("fulldisk");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 6);
   MapStore::save(path, *filter, "old");
@@ -219,7 +198,6 @@ TEST_CASE("GIVEN a directory that does not exist WHEN a map is saved there THEN 
   CHECK_THROWS_WITH(MapStore::save("/nonexistent-toposlam-dir/map.tsm", *filter),
                     Catch::Contains("cannot create a temporary file in /nonexistent-toposlam-dir"));
 }
-
 
 // ---- recovery, lock, orphans, size cap, settings (issue 19) ------------------------------------------------
 
@@ -249,7 +227,8 @@ void flipMiddleByte(const fs::path& path) {
 TEST_CASE("GIVEN a damaged map and a good .prev WHEN recovered THEN .prev is loaded and the damaged file kept aside",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("recover");
+  const TempFolder temp("recover");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 5);
   MapStore::save(path, *filter, "first");
@@ -301,7 +280,8 @@ TEST_CASE("GIVEN a damaged map and a good .prev WHEN recovered THEN .prev is loa
 TEST_CASE("GIVEN a damaged map and a damaged .prev WHEN recovered THEN nothing loads and both are kept aside",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("recover-both");
+  const TempFolder temp("recover-both");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 4);
   MapStore::save(path, *filter, "first");
@@ -355,7 +335,8 @@ TEST_CASE("GIVEN a damaged map in a read-only directory WHEN recovered THEN the 
 
 TEST_CASE("GIVEN a map locked by one writer WHEN a second one locks it THEN it is refused naming the lock file",
           "[topology][map][reliability]") {
-  const fs::path dir = freshDirectory("lock");
+  const TempFolder temp("lock");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   {
     MapLock first = MapLock::acquire(path);
@@ -372,7 +353,8 @@ TEST_CASE("GIVEN a map locked by one writer WHEN a second one locks it THEN it i
 
 TEST_CASE("GIVEN temporary files of saves a kill -9 interrupted WHEN removed at start THEN only those go",
           "[topology][map][reliability]") {
-  const fs::path dir = freshDirectory("orphans");
+  const TempFolder temp("orphans");
+  const fs::path& dir = temp.path;
   for (const char* name : {".map.tsm.Ab3dE9", ".map.tsm.Zz0000.prev", "map.tsm", "map.tsm.prev", ".map.tsm.lock",
                            ".map.tsm.toolong7", ".other.tsm.Ab3dE9", "notes.txt"})
     writeAll(dir / name, "x");
@@ -384,7 +366,8 @@ TEST_CASE("GIVEN temporary files of saves a kill -9 interrupted WHEN removed at 
 TEST_CASE("GIVEN a map file over the size cap WHEN loaded or recovered THEN it is refused unread and moved nowhere",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("sizecap");
+  const TempFolder temp("sizecap");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 4);
   MapStore::save(path, *filter, "small");
@@ -407,7 +390,8 @@ TEST_CASE("GIVEN a map file over the size cap WHEN loaded or recovered THEN it i
 TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run THEN refused naming both",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("settings");
+  const TempFolder temp("settings");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   auto filter = smallFilter(sim, 3);
   VpackConfig orb;
@@ -464,7 +448,8 @@ TEST_CASE("GIVEN saves killed with SIGKILL at random moments WHEN the map is rec
           "the orphaned temporaries are removed",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
-  const fs::path dir = freshDirectory("kill9");
+  const TempFolder temp("kill9");
+  const fs::path& dir = temp.path;
   const fs::path path = dir / "map.tsm";
   // Three map images of different sizes; whichever survives must be one of them, whole.
   std::vector<std::string> images;

@@ -1,5 +1,5 @@
 // Test helpers for the topology filter: fingerprints that carry only a tag (their image width - 1), and
-// a SimilarityMeasure that looks the similarity of two tags up in a hand-made function.
+// a SimilarityMeasure that looks the similarity of two tags up in a hand-made function, a small filter.
 #pragma once
 
 #include <atomic>
@@ -9,6 +9,7 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam::test {
 
@@ -44,6 +45,16 @@ class TagSimilarity : public SimilarityMeasure {
 /// Same place (tag) -> `same`, else `different`.
 inline TagSimilarity placeSimilarity(double same = 0.9, double different = 0.1) {
   return TagSimilarity([=](int a, int b) { return a == b ? same : different; });
+}
+
+/// A 50-particle filter (seed 3) stepped `steps` times over the tags 0, 1, 2, 3, 0, ...: a small map.
+inline std::unique_ptr<TopologyParticleFilter> smallFilter(const SimilarityMeasure& similarity, int steps) {
+  TopologyFilterConfig config;
+  config.particles = 50;
+  config.seed = 3;
+  auto filter = std::make_unique<TopologyParticleFilter>(config, similarity);
+  for (int k = 0; k < steps; ++k) filter->step(taggedFingerprint(k % 4));
+  return filter;
 }
 
 }  // namespace toposlam::test

@@ -16,20 +16,8 @@
 
 using namespace toposlam;
 using toposlam::test::placeSimilarity;
+using toposlam::test::smallFilter;
 using toposlam::test::taggedFingerprint;
-
-namespace {
-
-std::unique_ptr<TopologyParticleFilter> smallFilter(const SimilarityMeasure& sim, int steps) {
-  TopologyFilterConfig c;
-  c.particles = 50;
-  c.seed = 3;
-  auto filter = std::make_unique<TopologyParticleFilter>(c, sim);
-  for (int k = 0; k < steps; ++k) filter->step(taggedFingerprint(k % 4));
-  return filter;
-}
-
-}  // namespace
 
 TEST_CASE(
     "GIVEN every truncation and byte flips of a filter state WHEN loaded THEN it throws or loads, never "

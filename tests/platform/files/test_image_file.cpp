@@ -10,7 +10,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "temp_folder.hpp"
+#include "test_files.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "toposlam/io/source_factory.hpp"

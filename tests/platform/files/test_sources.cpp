@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "temp_folder.hpp"
+#include "test_files.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/io/sim_source.hpp"
 #include "toposlam/io/source_factory.hpp"

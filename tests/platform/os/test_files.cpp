@@ -12,35 +12,18 @@
 #include <sstream>
 #include <string>
 
+#include "test_files.hpp"
 #include "toposlam/platform/atomic_file.hpp"
 #include "toposlam/platform/file_lock.hpp"
 #include "toposlam/platform/file_system.hpp"
 
 using namespace toposlam;
 namespace fs = std::filesystem;
+using toposlam::test::filesIn;
+using toposlam::test::readAll;
+using toposlam::test::TempFolder;
 
 namespace {
-
-fs::path freshDirectory(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("toposlam-files-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string readAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
-
-std::size_t filesIn(const fs::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n;
-  return n;
-}
 
 /// Every write fails with ENOSPC.
 class FullDisk : public FileWriteOps {
@@ -56,7 +39,8 @@ class FullDisk : public FileWriteOps {
 SCENARIO(
     "GIVEN a file WHEN it is replaced atomically THEN the new content is there, or on a failure the old "
     "one and no temporary") {
-  const fs::path dir = freshDirectory("atomic");
+  const TempFolder temp("atomic");
+  const fs::path& dir = temp.path;
   const fs::path target = dir / "out.txt";
   {
     AtomicFileWrite write(target, ".");
@@ -86,7 +70,8 @@ SCENARIO(
 SCENARIO(
     "GIVEN a file locked once WHEN it is locked again THEN that is refused naming this process, until "
     "the lock's owner is gone") {
-  const fs::path dir = freshDirectory("lock");
+  const TempFolder temp("lock");
+  const fs::path& dir = temp.path;
   const fs::path file = dir / "x.lock";
   {
     FileLockFailure failure;
@@ -113,7 +98,8 @@ SCENARIO(
 
 SCENARIO(
     "GIVEN files and folders WHEN read, linked, renamed and removed THEN each says what the system said") {
-  const fs::path dir = freshDirectory("calls");
+  const TempFolder temp("calls");
+  const fs::path& dir = temp.path;
   { std::ofstream(dir / "a") << "hello"; }
   ReadableFile a(dir / "a");
   REQUIRE(a.status() == ReadableFile::Status::open);

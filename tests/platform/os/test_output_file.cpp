@@ -12,38 +12,19 @@
 #include <fstream>
 #include <sstream>
 
+#include "test_files.hpp"
 #include "toposlam/platform/output_file.hpp"
 
 using namespace toposlam;
 namespace fs = std::filesystem;
-
-namespace {
-
-fs::path freshDirectory(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("toposlam-output-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string readAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
-
-std::size_t filesIn(const fs::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n;
-  return n;
-}
-
-}  // namespace
+using toposlam::test::filesIn;
+using toposlam::test::readAll;
+using toposlam::test::TempFolder;
 
 TEST_CASE("GIVEN an output file WHEN committed THEN the target holds the text and no temporary file is left",
           "[core][output][reliability]") {
-  const fs::path dir = freshDirectory("commit");
+  const TempFolder temp("commit");
+  const fs::path& dir = temp.path;
   const fs::path target = dir / "frames.csv";
   std::ofstream(target) << "old";
   {
@@ -82,7 +63,8 @@ TEST_CASE("GIVEN a folder that does not exist WHEN an output file is opened ther
 
 TEST_CASE("GIVEN a disk that fills up WHEN a large file is committed THEN it throws naming it and the old file stays",
           "[core][output][reliability]") {
-  const fs::path dir = freshDirectory("full");
+  const TempFolder temp("full");
+  const fs::path& dir = temp.path;
   const fs::path target = dir / "timing.csv";
   std::ofstream(target) << "old";
   const pid_t child = fork();
