@@ -400,6 +400,8 @@ int runDaemon(const DaemonConfig& config) {
   const PipelineStatus last = pipeline.status();
   spdlog::info("toposlamd: {} frames published, {} dropped, {} places, {} map saves",
                last.frames_published, last.frames_dropped, last.places, last.maps_saved);
+  if (const std::int64_t unsent = notifier.droppedNotifications(); unsent > 0)
+    spdlog::warn("toposlamd: {} service notifications found systemd's notify socket full and were dropped", unsent);
   if (!error.empty()) {
     notifier.status("failed: " + error);
     spdlog::error("toposlamd: {}", error);
