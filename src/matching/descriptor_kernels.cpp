@@ -36,17 +36,20 @@ template <typename Distance>
 // Best and second best reference row per query row. kWords > 0 fixes the row length at compile time
 // (the inner loop unrolls to kWords XOR + popcount); kWords == 0 takes it from `words` at run time.
 // With reference_best (and its scratch reference_best_distance, reference_count each), also the best
-// query row of every reference row (ties: the earlier query row), from the same distances.
-template <int kWords>
+// query row of every reference row (ties: the earlier query row), from the same distances; with
+// kReferenceSecond also its second best distance (reference_second_distance), so the pass answers the
+// reverse direction in full.
+template <int kWords, bool kReferenceSecond>
 [[gnu::always_inline]] inline void scanBinary(const std::uint64_t* query, int query_count,
                                               const std::uint64_t* reference, int reference_count,
                                               int words, DescriptorMatch* out, int* reference_best,
-                                              int* reference_best_distance) {
+                                              int* reference_best_distance, int* reference_second_distance) {
   const int row_words = kWords > 0 ? kWords : words;
   if (reference_best != nullptr) {
     for (int r = 0; r < reference_count; ++r) {
       reference_best[r] = -1;
       reference_best_distance[r] = std::numeric_limits<int>::max();
+      if constexpr (kReferenceSecond) reference_second_distance[r] = std::numeric_limits<int>::max();
     }
   }
   for (int q = 0; q < query_count; ++q) {
@@ -59,7 +62,10 @@ template <int kWords>
       int distance = 0;
       for (int w = 0; w < row_words; ++w) distance += std::popcount(qrow[w] ^ rrow[w]);
       consider(distance, r, best, second, best_row);
-      if (reference_best != nullptr && distance < reference_best_distance[r]) {
+      if constexpr (kReferenceSecond) {
+        // Query rows arrive in order, so this is consider() run over the reverse direction.
+        consider(distance, q, reference_best_distance[r], reference_second_distance[r], reference_best[r]);
+      } else if (reference_best != nullptr && distance < reference_best_distance[r]) {
         reference_best_distance[r] = distance;
         reference_best[r] = q;
       }
@@ -72,25 +78,49 @@ template <int kWords>
   }
 }
 
+template <bool kReferenceSecond>
+[[gnu::always_inline]] inline void scanBinaryRows(const std::uint64_t* query, int query_count,
+                                                  const std::uint64_t* reference, int reference_count, int words,
+                                                  DescriptorMatch* out, int* reference_best,
+                                                  int* reference_best_distance, int* reference_second_distance) {
+  switch (words) {
+    case 4:  // ORB, 32 bytes
+      scanBinary<4, kReferenceSecond>(query, query_count, reference, reference_count, words, out, reference_best,
+                                      reference_best_distance, reference_second_distance);
+      break;
+    case 8:  // BRISK (64 bytes), AKAZE-MLDB (61 bytes, padded)
+      scanBinary<8, kReferenceSecond>(query, query_count, reference, reference_count, words, out, reference_best,
+                                      reference_best_distance, reference_second_distance);
+      break;
+    default:
+      scanBinary<0, kReferenceSecond>(query, query_count, reference, reference_count, words, out, reference_best,
+                                      reference_best_distance, reference_second_distance);
+      break;
+  }
+}
+
 }  // namespace
 
 TOPOSLAM_POPCOUNT_CLONES
 void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
                        int reference_count, int words, DescriptorMatch* out, int* reference_best,
                        int* reference_best_distance) {
-  switch (words) {
-    case 4:  // ORB, 32 bytes
-      scanBinary<4>(query, query_count, reference, reference_count, words, out, reference_best,
-                    reference_best_distance);
-      break;
-    case 8:  // BRISK (64 bytes), AKAZE-MLDB (61 bytes, padded)
-      scanBinary<8>(query, query_count, reference, reference_count, words, out, reference_best,
-                    reference_best_distance);
-      break;
-    default:
-      scanBinary<0>(query, query_count, reference, reference_count, words, out, reference_best,
-                    reference_best_distance);
-      break;
+  scanBinaryRows<false>(query, query_count, reference, reference_count, words, out, reference_best,
+                        reference_best_distance, nullptr);
+}
+
+TOPOSLAM_POPCOUNT_CLONES
+void bestBinaryMatchesBothWays(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
+                               int reference_count, int words, DescriptorMatch* out, DescriptorMatch* reverse_out,
+                               int* reference_best, int* reference_best_distance, int* reference_second_distance) {
+  scanBinaryRows<true>(query, query_count, reference, reference_count, words, out, reference_best,
+                       reference_best_distance, reference_second_distance);
+  for (int r = 0; r < reference_count; ++r) {
+    reverse_out[r].reference_keypoint = reference_best[r];
+    reverse_out[r].distance = static_cast<float>(reference_best_distance[r]);
+    reverse_out[r].second_distance = reference_second_distance[r] == std::numeric_limits<int>::max()
+                                         ? std::numeric_limits<float>::infinity()
+                                         : static_cast<float>(reference_second_distance[r]);
   }
 }
 

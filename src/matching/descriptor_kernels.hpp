@@ -21,6 +21,15 @@ void bestBinaryMatches(const std::uint64_t* query, int query_count, const std::u
                        int reference_count, int words, DescriptorMatch* out, int* reference_best = nullptr,
                        int* reference_best_distance = nullptr);
 
+/// bestBinaryMatches with reference_best, and the whole reverse direction from the same distances:
+/// reverse_out[r] (reference_count of them) is what bestBinaryMatches(reference, query) would give reference
+/// row r, its best query row (ties: the earlier), that distance and the second best. reference_best,
+/// reference_best_distance and reference_second_distance are reference_count each (the last two scratch).
+/// One pass for both directions of a symmetric similarity.
+void bestBinaryMatchesBothWays(const std::uint64_t* query, int query_count, const std::uint64_t* reference,
+                               int reference_count, int words, DescriptorMatch* out, DescriptorMatch* reverse_out,
+                               int* reference_best, int* reference_best_distance, int* reference_second_distance);
+
 /// Same for float rows of `dims` values (row strides in floats); distances are L2 (not squared).
 void bestFloatMatches(const float* query, int query_count, int query_stride, const float* reference,
                       int reference_count, int reference_stride, int dims, DescriptorMatch* out,

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "descriptor_kernels.hpp"
 
@@ -196,8 +197,10 @@ void NgramMatcher::matchHistograms(const Fingerprint& reference, const Fingerpri
   }
 }
 
-int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint& query,
-                                 MatchScratch& s) const {
+int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s,
+                                 ReversePass reverse) const {
+  const bool take_reverse = reverse == ReversePass::Take && s.reverse_ready;
+  s.reverse_ready = false;  // a kept reverse serves the very next call only
   const int m = static_cast<int>(reference.subregions.size());
   const int q = static_cast<int>(query.subregions.size());
   const std::size_t cells = static_cast<std::size_t>(m) * static_cast<std::size_t>(q);
@@ -213,12 +216,32 @@ int NgramMatcher::matchKeypoints(const Fingerprint& reference, const Fingerprint
   double max_distance = std::numeric_limits<double>::infinity();
   if (rd.depth() == CV_8U) {
     const int words = (rd.cols + 7) / 8;
-    packBinaryRows(rd, words, s.reference_words);
-    packBinaryRows(qd, words, s.query_words);
-    if (mutual) resizeFor(s.reference_best_bits, static_cast<std::size_t>(rd.rows), 0);
-    detail::bestBinaryMatches(s.query_words.data(), qd.rows, s.reference_words.data(), rd.rows, words,
-                              s.matches.data(), mutual ? s.reference_best.data() : nullptr,
-                              mutual ? s.reference_best_bits.data() : nullptr);
+    if (take_reverse) {
+      // The previous call matched (reference = this query, query = this reference) and kept both ways.
+      std::swap(s.reference_words, s.query_words);
+      s.matches.swap(s.reverse_matches);
+      if (mutual) s.reference_best.swap(s.reverse_reference_best);
+    } else if (reverse == ReversePass::Keep) {
+      packBinaryRows(rd, words, s.reference_words);
+      packBinaryRows(qd, words, s.query_words);
+      resizeFor(s.reference_best, static_cast<std::size_t>(rd.rows), -1);
+      resizeFor(s.reference_best_bits, static_cast<std::size_t>(rd.rows), 0);
+      resizeFor(s.reference_second_bits, static_cast<std::size_t>(rd.rows), 0);
+      resizeFor(s.reverse_matches, static_cast<std::size_t>(rd.rows), DescriptorMatch{});
+      detail::bestBinaryMatchesBothWays(s.query_words.data(), qd.rows, s.reference_words.data(), rd.rows, words,
+                                        s.matches.data(), s.reverse_matches.data(), s.reference_best.data(),
+                                        s.reference_best_bits.data(), s.reference_second_bits.data());
+      resizeFor(s.reverse_reference_best, static_cast<std::size_t>(qd.rows), -1);
+      for (int k = 0; k < qd.rows; ++k) s.reverse_reference_best[k] = s.matches[k].reference_keypoint;
+      s.reverse_ready = true;
+    } else {
+      packBinaryRows(rd, words, s.reference_words);
+      packBinaryRows(qd, words, s.query_words);
+      if (mutual) resizeFor(s.reference_best_bits, static_cast<std::size_t>(rd.rows), 0);
+      detail::bestBinaryMatches(s.query_words.data(), qd.rows, s.reference_words.data(), rd.rows, words,
+                                s.matches.data(), mutual ? s.reference_best.data() : nullptr,
+                                mutual ? s.reference_best_bits.data() : nullptr);
+    }
     if (config_.max_binary_distance_fraction < 1.0) max_distance = config_.max_binary_distance_fraction * 8.0 * rd.cols;
   } else {
     // cv::Mat rows may be padded: pass strides in floats (step is a multiple of 4 for CV_32F).
@@ -408,14 +431,26 @@ void NgramMatcher::verifiedMatchCounts(int m, int q, MatchScratch& s, NgramCount
 
 NgramCounts NgramMatcher::counts(const Fingerprint& reference, const Fingerprint& query,
                                  MatchScratch* scratch) const {
+  return countsWith(reference, query, scratch != nullptr ? *scratch : threadScratch(), ReversePass::None);
+}
+
+std::pair<NgramCounts, NgramCounts> NgramMatcher::countsBothWays(const Fingerprint& a, const Fingerprint& b,
+                                                                 MatchScratch* scratch) const {
   MatchScratch& s = scratch != nullptr ? *scratch : threadScratch();
+  NgramCounts forward = countsWith(a, b, s, ReversePass::Keep);
+  NgramCounts backward = countsWith(b, a, s, ReversePass::Take);
+  return {std::move(forward), std::move(backward)};
+}
+
+NgramCounts NgramMatcher::countsWith(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s,
+                                     ReversePass reverse) const {
   NgramCounts result;
   const int m = static_cast<int>(reference.subregions.size());
   const int q = static_cast<int>(query.subregions.size());
   result.query_keypoints = hasDescriptors(query) ? query.descriptors.rows : 0;
 
   matchHistograms(reference, query, s);
-  result.matched_keypoints = matchKeypoints(reference, query, s);
+  result.matched_keypoints = matchKeypoints(reference, query, s, reverse);
 
   const bool reference_has_keypoints = hasDescriptors(reference);
   result.reference_keypoints = reference_has_keypoints ? reference.descriptors.rows : 0;

@@ -90,6 +90,11 @@ double NgramSimilarity::similarity(const Fingerprint& reference, const Fingerpri
   return fromCounts(matcher_.counts(reference, query, &scratch), config_).similarity;
 }
 
+double NgramSimilarity::symmetricSimilarity(const Fingerprint& a, const Fingerprint& b) const {
+  const auto [forward, backward] = matcher_.countsBothWays(a, b);
+  return 0.5 * (fromCounts(forward, config_).similarity + fromCounts(backward, config_).similarity);
+}
+
 SimilarityBreakdown NgramSimilarity::explain(const Fingerprint& reference, const Fingerprint& query) const {
   return fromCounts(matcher_.counts(reference, query), config_);
 }

@@ -205,3 +205,50 @@ SCENARIO(
   CHECK(reached == Approx(28).margin(3));
   CHECK(precision_05 >= 0.70);
 }
+
+namespace {
+
+bool sameCounts(const NgramCounts& a, const NgramCounts& b) {
+  return a.histogram == b.histogram && a.keypoint == b.keypoint && a.histogram_matched == b.histogram_matched &&
+         a.keypoint_matched == b.keypoint_matched && a.histogram_possible == b.histogram_possible &&
+         a.keypoint_possible == b.keypoint_possible && a.query_keypoints == b.query_keypoints &&
+         a.reference_keypoints == b.reference_keypoints && a.query_letters == b.query_letters &&
+         a.matched_keypoints == b.matched_keypoints && a.keypoint_ngram_matches == b.keypoint_ngram_matches &&
+         a.aligned_matches == b.aligned_matches;
+}
+
+}  // namespace
+
+SCENARIO("GIVEN real frames WHEN both directions come from one descriptor pass THEN they equal two separate passes") {
+  // countsBothWays keeps the reverse direction of its first pass for the second half; every count and the
+  // symmetric similarity must equal the two plain calls exactly, ties included, with and without the
+  // mutual check and the ratio test.
+  const std::vector<Fingerprint>& f = frames();
+  for (const bool mutual : {false, true}) {
+    for (const double ratio : {0.9, 1.0}) {
+      NgramSimilarityConfig config;
+      config.matcher.mutual_check = mutual;
+      config.matcher.ratio_test = ratio;
+      const NgramSimilarity similarity(config);
+      const NgramMatcher& matcher = similarity.matcher();
+      int pairs = 0, differing = 0, with_matches = 0;
+      for (std::size_t a = 0; a < f.size(); a += 5) {
+        for (std::size_t b = 0; b < f.size(); b += 7) {
+          const auto [forward, backward] = matcher.countsBothWays(f[a], f[b]);
+          const NgramCounts plain_forward = matcher.counts(f[a], f[b]);
+          const NgramCounts plain_backward = matcher.counts(f[b], f[a]);
+          const double plain = 0.5 * (similarity.similarity(f[a], f[b]) + similarity.similarity(f[b], f[a]));
+          ++pairs;
+          if (!sameCounts(forward, plain_forward) || !sameCounts(backward, plain_backward) ||
+              similarity.symmetricSimilarity(f[a], f[b]) != plain)
+            ++differing;
+          if (forward.matched_keypoints > 0 && backward.matched_keypoints > 0) ++with_matches;
+        }
+      }
+      INFO("mutual " << mutual << ", ratio " << ratio);
+      CHECK(pairs == 17 * 12);
+      CHECK(differing == 0);
+      CHECK(with_matches > pairs / 2);  // the pass was exercised, not skipped
+    }
+  }
+}

@@ -26,6 +26,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "toposlam/fingerprint/fingerprint.hpp"
@@ -119,6 +120,11 @@ struct MatchScratch {
   std::vector<int> reference_best_bits;  ///< scratch of the binary kernel
   std::vector<float> reference_best_l2;  ///< scratch of the float kernel
   std::vector<int> alignment;            ///< reference letters x query letters, alignment DP
+  // The reverse direction of the last binary pass, kept by countsBothWays() for its second half.
+  std::vector<DescriptorMatch> reverse_matches;  ///< per reference keypoint: its best query keypoint
+  std::vector<int> reverse_reference_best;       ///< per query keypoint: its best reference keypoint
+  std::vector<int> reference_second_bits;        ///< scratch of the both-ways binary kernel
+  bool reverse_ready = false;
 };
 
 class NgramMatcher {
@@ -132,6 +138,11 @@ class NgramMatcher {
   /// count). Never throws on well-formed fingerprints (Fingerprint::validate() == "").
   NgramCounts counts(const Fingerprint& reference, const Fingerprint& query,
                      MatchScratch* scratch = nullptr) const;
+
+  /// counts(a, b) and counts(b, a), equal to the two calls to the last bit, with one descriptor pass for
+  /// both directions when the descriptors are binary (a symmetric similarity's cost nearly halved).
+  std::pair<NgramCounts, NgramCounts> countsBothWays(const Fingerprint& a, const Fingerprint& b,
+                                                     MatchScratch* scratch = nullptr) const;
 
   /// The letter correspondences behind counts() (allocates; for the CLI, drawings and tests).
   LetterCorrespondences correspondences(const Fingerprint& reference, const Fingerprint& query) const;
@@ -150,9 +161,15 @@ class NgramMatcher {
                             int* matched);
 
  private:
+  /// What a binary descriptor pass does with the reverse direction: nothing, keep it in the scratch (the
+  /// first half of countsBothWays), or take the kept one instead of a pass (the second half).
+  enum class ReversePass { None, Keep, Take };
+  NgramCounts countsWith(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s,
+                         ReversePass reverse) const;
   void matchHistograms(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s) const;
   /// Returns the number of query keypoints whose match was kept.
-  int matchKeypoints(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s) const;
+  int matchKeypoints(const Fingerprint& reference, const Fingerprint& query, MatchScratch& s,
+                     ReversePass reverse = ReversePass::None) const;
   /// Fills keypoint_ngram_matches and aligned_matches from s.pair_matches (m x q).
   static void verifiedMatchCounts(int m, int q, MatchScratch& s, NgramCounts& result);
 

@@ -66,6 +66,9 @@ class NgramSimilarity : public SimilarityMeasure {
   double similarity(const Fingerprint& reference, const Fingerprint& query) const override;
   /// Same as similarity() with caller-provided scratch buffers.
   double similarity(const Fingerprint& reference, const Fingerprint& query, MatchScratch& scratch) const;
+  /// 0.5 * (similarity(a, b) + similarity(b, a)), bit for bit, with one descriptor pass for both
+  /// (NgramMatcher::countsBothWays).
+  double symmetricSimilarity(const Fingerprint& a, const Fingerprint& b) const override;
   SimilarityBreakdown explain(const Fingerprint& reference, const Fingerprint& query) const;
 
   /// The normalisation above applied to counts computed elsewhere (e.g. by PlaceLocalizer).

@@ -12,8 +12,9 @@ class SimilarityMeasure {
   /// How well `query` matches `reference`, in [0, 1]; not symmetric in general.
   /// Thread-safety: implementations are const and may be called concurrently.
   virtual double similarity(const Fingerprint& reference, const Fingerprint& query) const = 0;
-  /// Mean of both directions (chapter 4 needs a symmetric affinity).
-  double symmetricSimilarity(const Fingerprint& a, const Fingerprint& b) const {
+  /// Mean of both directions (chapter 4 needs a symmetric affinity). An implementation may compute both
+  /// at once, to the same value.
+  virtual double symmetricSimilarity(const Fingerprint& a, const Fingerprint& b) const {
     return 0.5 * (similarity(a, b) + similarity(b, a));
   }
 };
