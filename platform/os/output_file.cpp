@@ -8,41 +8,40 @@
 #include <cerrno>
 #include <cstring>
 #include <streambuf>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace toposlam {
 
-/// A write-only stream buffer over a descriptor that remembers the first write error (errno).
+/// A write-only stream buffer that remembers the first write error (errno). It writes through the
+/// AtomicFileWrite of a regular file, or straight to the descriptor of a special file written in place.
 class OutputFile::Buffer : public std::streambuf {
  public:
-  explicit Buffer(int fd) : fd_(fd), data_(64 * 1024) { setp(data_.data(), data_.data() + data_.size()); }
+  Buffer(AtomicFileWrite* atomic, int fd, const FileWriteOps& ops)
+      : atomic_(atomic), fd_(fd), ops_(ops), data_(64 * 1024) {
+    setp(data_.data(), data_.data() + data_.size());
+  }
   ~Buffer() override {
     if (fd_ >= 0) ::close(fd_);
   }
-  int fd() const { return fd_; }
   int error() const { return error_; }
+  const FileWriteOps& ops() const { return ops_; }
   /// Writes out what is buffered; false (error() set) on failure.
   bool drain() {
-    const char* p = pbase();
-    std::size_t left = static_cast<std::size_t>(pptr() - pbase());
-    while (left > 0 && error_ == 0) {
-      const ssize_t n = ::write(fd_, p, left);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        error_ = n < 0 ? errno : EIO;
-        break;
-      }
-      p += n;
-      left -= static_cast<std::size_t>(n);
-    }
+    const std::string_view pending(pbase(), static_cast<std::size_t>(pptr() - pbase()));
+    if (!pending.empty() && error_ == 0) fail(atomic_ != nullptr ? atomic_->write(pending, ops_) : writeInPlace(pending));
     setp(data_.data(), data_.data() + data_.size());
     return error_ == 0;
   }
-  /// Closes the descriptor; false (error() set) when close reports a deferred write error.
+  /// Closes what was written (a deferred write error shows here): false (error() set) on failure.
   bool close() {
-    const int fd = fd_;
-    fd_ = -1;
-    if (fd >= 0 && ::close(fd) != 0 && error_ == 0) error_ = errno;
+    if (atomic_ != nullptr) {
+      if (error_ == 0) fail(atomic_->sync(ops_));
+      fail(atomic_->close());
+    } else if (const int fd = std::exchange(fd_, -1); fd >= 0 && ::close(fd) != 0) {
+      fail(errno);
+    }
     return error_ == 0;
   }
   void fail(int error) {
@@ -61,42 +60,54 @@ class OutputFile::Buffer : public std::streambuf {
   int sync() override { return drain() ? 0 : -1; }
 
  private:
+  int writeInPlace(std::string_view bytes) const {
+    while (!bytes.empty()) {
+      const long n = ops_.write(fd_, bytes.data(), bytes.size());
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return n < 0 ? errno : EIO;
+      bytes.remove_prefix(static_cast<std::size_t>(n));
+    }
+    return 0;
+  }
+
+  AtomicFileWrite* atomic_;  ///< null: writing in place to fd_
   int fd_;
+  const FileWriteOps& ops_;
   std::vector<char> data_;
   int error_ = 0;
 };
 
-OutputFile::OutputFile(std::filesystem::path target) : std::ostream(nullptr), target_(std::move(target)) {
+namespace {
+const FileWriteOps kSystemOps;
+}  // namespace
+
+OutputFile::OutputFile(std::filesystem::path target, const FileWriteOps* ops)
+    : std::ostream(nullptr), target_(std::move(target)) {
+  const FileWriteOps& calls = ops != nullptr ? *ops : kSystemOps;
   struct stat st {};
   const bool special = ::stat(target_.c_str(), &st) == 0 && !S_ISREG(st.st_mode);
   if (special && S_ISDIR(st.st_mode)) throw OutputFileError(target_.string() + ": cannot write: is a folder");
   int fd = -1;
+  int error = 0;
   if (special) {
     fd = ::open(target_.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) error = errno;
   } else {
-    const std::filesystem::path dir = target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
-    std::string name = ".";  // built piecewise: GCC 12 warns falsely (-Wrestrict) on "." + string
-    name += target_.filename().string();
-    name += ".tmp-XXXXXX";
-    std::string pattern = (dir / name).string();
-    fd = ::mkstemp(pattern.data());
-    if (fd >= 0) {
-      temp_ = pattern;
-      ::fchmod(fd, 0644);  // mkstemp creates 0600; outputs are for everyone to read (best effort)
-    }
+    atomic_ = std::make_unique<AtomicFileWrite>(target_, ".tmp-");
+    error = atomic_->create();  // mode 0644: outputs are for everyone to read
   }
-  if (fd < 0) {
-    throw OutputFileError(target_.string() + ": cannot create file: " + std::strerror(errno) +
+  if (error != 0) {
+    throw OutputFileError(target_.string() + ": cannot create file: " + std::strerror(error) +
                           " (is the folder writable?)");
   }
-  buffer_ = std::make_unique<Buffer>(fd);
+  buffer_ = std::make_unique<Buffer>(atomic_.get(), fd, calls);
   rdbuf(buffer_.get());
 }
 
 OutputFile::~OutputFile() {
   rdbuf(nullptr);
   buffer_.reset();
-  if (!committed_ && !temp_.empty()) ::unlink(temp_.c_str());
+  atomic_.reset();  // not committed: closes and removes the temporary file
 }
 
 void OutputFile::commit() {
@@ -104,25 +115,28 @@ void OutputFile::commit() {
   flush();
   bool ok = buffer_->drain() && !fail();
   if (!ok && buffer_->error() == 0) buffer_->fail(EIO);  // a formatting failure inside the stream
-  if (ok && !temp_.empty() && ::fsync(buffer_->fd()) != 0) buffer_->fail(errno);
-  ok = buffer_->close() && ok && buffer_->error() == 0;
+  ok = buffer_->close() && ok;
   if (!ok) {
     const std::string reason = std::strerror(buffer_->error());
-    const bool replaced_nothing = !temp_.empty();
-    if (replaced_nothing) ::unlink(temp_.c_str());
-    temp_.clear();
+    const bool replaced_nothing = atomic_ != nullptr;
+    atomic_.reset();  // removes the temporary file
     setstate(std::ios::badbit);
     throw OutputFileError(target_.string() + ": write failed: " + reason +
                           (replaced_nothing ? " (the file was not written)" : ""));
   }
-  if (!temp_.empty()) {
-    if (::rename(temp_.c_str(), target_.c_str()) != 0) {
-      const int error = errno;
-      ::unlink(temp_.c_str());
-      temp_.clear();
+  if (atomic_ != nullptr) {
+    if (const int error = atomic_->replaceTarget(); error != 0) {
+      atomic_.reset();
+      setstate(std::ios::badbit);
       throw OutputFileError(target_.string() + ": cannot replace it: " + std::strerror(error));
     }
-    temp_.clear();
+    const int error = atomic_->syncFolder(buffer_->ops());
+    atomic_.reset();
+    if (error != 0) {
+      setstate(std::ios::badbit);
+      throw OutputFileError(target_.string() + ": written, but its folder could not be flushed (the new file may "
+                            "not survive a power cut): " + std::strerror(error));
+    }
   }
   committed_ = true;
 }

@@ -5,6 +5,8 @@
 #include <signal.h>
 
 #include <cerrno>
+#include <cmath>
+#include <ctime>
 
 namespace toposlam {
 
@@ -23,5 +25,27 @@ int changeMask(int how, const std::vector<int>& signals) {
 int blockSignals(const std::vector<int>& signals) { return changeMask(SIG_BLOCK, signals); }
 
 int unblockSignals(const std::vector<int>& signals) { return changeMask(SIG_UNBLOCK, signals); }
+
+int waitForSignal(const std::vector<int>& signals, double seconds) {
+  sigset_t set;
+  sigemptyset(&set);
+  for (int s : signals) sigaddset(&set, s);
+  const double wait = seconds > 0.0 ? seconds : 0.0;
+  timespec timeout{};
+  timeout.tv_sec = static_cast<time_t>(wait);
+  timeout.tv_nsec = static_cast<long>((wait - std::floor(wait)) * 1e9);
+  const int signal = sigtimedwait(&set, nullptr, &timeout);
+  return signal > 0 ? signal : 0;
+}
+
+int catchSignals(const std::vector<int>& signals, void (*handler)(int)) {
+  struct sigaction action {};
+  action.sa_handler = handler;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART
+  for (int s : signals)
+    if (sigaction(s, &action, nullptr) != 0) return errno;
+  return unblockSignals(signals);
+}
 
 }  // namespace toposlam

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <string>
 
 namespace toposlam {
 
@@ -23,6 +24,10 @@ double clockSeconds(clockid_t clock) {
 
 int setCurrentThreadName(const std::string& name) {
   return pthread_setname_np(pthread_self(), name.substr(0, 15).c_str());
+}
+
+std::function<void(int worker)> namedWorkers(const std::string& prefix) {
+  return [prefix](int worker) { setCurrentThreadName(prefix + "-" + std::to_string(worker)); };
 }
 
 int pinCurrentThread(int cpu) {

@@ -1,20 +1,18 @@
 // WorkerPool: a fixed set of threads that run batches of indexed tasks; see the header.
 #include "toposlam/core/worker_pool.hpp"
 
-#include <pthread.h>
-
 #include <stdexcept>
 
 namespace toposlam {
 
-WorkerPool::WorkerPool(int total_workers, std::string name) {
+WorkerPool::WorkerPool(int total_workers, std::function<void(int worker)> on_thread_start) {
   if (total_workers < 1) throw std::invalid_argument("WorkerPool: total_workers must be >= 1");
   threads_.reserve(static_cast<std::size_t>(total_workers - 1));
   for (int i = 1; i < total_workers; ++i) {
-    threads_.emplace_back([this] { workerLoop(); });
-    // Linux limits thread names to 15 characters.
-    std::string thread_name = (name + "-" + std::to_string(i)).substr(0, 15);
-    pthread_setname_np(threads_.back().native_handle(), thread_name.c_str());
+    threads_.emplace_back([this, i, on_thread_start] {
+      if (on_thread_start) on_thread_start(i);
+      workerLoop();
+    });
   }
 }
 

@@ -1,5 +1,8 @@
 // Core utilities: natural ordering, the worker pool, the JSON writer.
+#include <algorithm>
 #include <atomic>
+#include <mutex>
+#include <vector>
 #include <sstream>
 
 #include <catch2/catch.hpp>
@@ -29,6 +32,22 @@ TEST_CASE("GIVEN a pool WHEN a batch runs THEN every task runs exactly once, for
       for (auto& h : hits) REQUIRE(h.load() == 1);
     }
   }
+}
+
+TEST_CASE("GIVEN a pool with a start hook WHEN it is built THEN each extra worker runs the hook once, numbered 1 .. N-1") {
+  std::mutex mutex;
+  std::vector<int> started;
+  {
+    WorkerPool pool(4, [&](int worker) {
+      std::lock_guard lock(mutex);
+      started.push_back(worker);
+    });
+    std::atomic<int> hits{0};
+    pool.run(8, [&](std::size_t) { hits.fetch_add(1); });
+    CHECK(hits.load() == 8);
+  }  // joined: every hook has run
+  std::sort(started.begin(), started.end());
+  CHECK(started == std::vector<int>{1, 2, 3});
 }
 
 TEST_CASE("GIVEN a failing task WHEN the batch runs THEN the error reaches the caller after the batch") {

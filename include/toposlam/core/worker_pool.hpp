@@ -1,6 +1,8 @@
-// A fixed pool of named worker threads, created once and joined on destruction. Used to run the
-// per-subregion work of one frame in parallel (no thread per frame). run() blocks until every task of
-// the batch is done; the calling thread works too, so a pool of size 1 has no extra thread at all.
+// A fixed pool of worker threads, created once and joined on destruction. Used to run the per-subregion
+// work of one frame in parallel (no thread per frame). run() blocks until every task of the batch is done;
+// the calling thread works too, so a pool of size 1 has no extra thread at all. No OS calls of its own:
+// a caller that wants the threads named (or pinned) passes `on_thread_start`, which each worker runs first
+// (the programs pass platform/os's setCurrentThreadName, see namedWorkers() in thread_os.hpp).
 //
 // Thread-safety: run() may be called from one thread at a time.
 #pragma once
@@ -9,7 +11,6 @@
 #include <cstddef>
 #include <functional>
 #include <mutex>
-#include <string>
 #include <thread>
 #include <vector>
 
@@ -17,8 +18,9 @@ namespace toposlam {
 
 class WorkerPool {
  public:
-  /// total_workers counts the caller: 1 means "run inline", N means N-1 extra threads.
-  explicit WorkerPool(int total_workers, std::string name = "toposlam-work");
+  /// total_workers counts the caller: 1 means "run inline", N means N-1 extra threads, numbered 1 .. N-1
+  /// for `on_thread_start` (run on each new thread before any task).
+  explicit WorkerPool(int total_workers, std::function<void(int worker)> on_thread_start = {});
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;

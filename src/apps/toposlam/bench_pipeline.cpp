@@ -32,6 +32,7 @@
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
 #include "toposlam/platform/process_resources.hpp"
+#include "toposlam/platform/thread_os.hpp"
 
 namespace toposlam::cli {
 
@@ -182,7 +183,7 @@ RunResult runOnce(const DaemonConfig& base, const PipelineBenchOptions& o, const
     LcmPipelineSink lcm(o.lcm_url, channels, c.lcm.jpeg_quality);
     RecordingSink sink(lcm);
     LoopedFrameSource source(images, o.source_fps, o.frames, paced ? o.rate : 0.0);
-    WorkerPool pool(c.fingerprint_stage.workers, "tsl-vpack");
+    WorkerPool pool(c.fingerprint_stage.workers, namedWorkers("tsl-vpack"));
     VpackFingerprintStage fingerprint(c.fingerprint, &pool);
     NgramSimilarity similarity(c.similarity);
     FiedlerSegmentationStage segmentation(c.segmentation, similarity, 600, c.segmentation_stage.motion);

@@ -13,6 +13,7 @@
 #include "image_input.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/platform/thread_os.hpp"
 
 namespace toposlam::cli {
 
@@ -78,7 +79,7 @@ void runFingerprintBench(const FingerprintBenchOptions& o) {
         for (int workers : o.workers) {
           VpackConfig config;
           config.keypoints.backend = parseKeypointBackend(backend);
-          WorkerPool pool(workers, "bench");
+          WorkerPool pool(workers, namedWorkers("bench"));
           VpackExtractor extractor(config, &pool);
           std::vector<double> ms;
           double keypoints = 0, edges = 0;

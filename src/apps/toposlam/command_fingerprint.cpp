@@ -13,6 +13,7 @@
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/platform/thread_os.hpp"
 
 namespace toposlam::cli {
 
@@ -80,7 +81,7 @@ void addFingerprintCommand(CLI::App& app) {
   cmd->callback([options] {
     VpackConfig config;
     config.keypoints.backend = parseKeypointBackend(options->keypoints);
-    WorkerPool pool(options->workers, "fingerprint");
+    WorkerPool pool(options->workers, namedWorkers("fingerprint"));
     VpackExtractor extractor(config, &pool);
     JsonWriter json(std::cout);
     if (options->json && options->images.size() > 1) json.beginArray();

@@ -10,8 +10,6 @@
 // `lcm.url: file://FILE?mode=w`), read with the pure LcmLogReader: the same lines, as fast as read; --hz
 // rates over the log's own time. `--run-folder DIR` also turns it into a run folder for `toposlam report`.
 // A corrupt or truncated log is an error naming the byte offset (after the messages before it).
-#include <signal.h>
-
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -49,17 +47,9 @@ const std::vector<int>& stopSignals() {
 // (the calling) thread, whose select() then returns EINTR.
 void blockStopSignals() { blockSignals(stopSignals()); }
 
-// sigaction without SA_RESTART: the handler only sets the flag, and the wait in select() returns EINTR
-// (which LcmSubscriber::handle treats as "look at the flag"), so the exit follows the signal at once.
-void catchStopSignals() {
-  struct sigaction action {};
-  action.sa_handler = onInterrupt;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-  unblockSignals(stopSignals());
-}
+// Without SA_RESTART (catchSignals): the handler only sets the flag, and the wait in select() returns
+// EINTR (which LcmSubscriber::handle treats as "look at the flag"), so the exit follows the signal at once.
+void catchStopSignals() { catchSignals(stopSignals(), onInterrupt); }
 
 std::vector<std::string> splitChannels(const std::string& text) {
   std::vector<std::string> out;

@@ -22,6 +22,7 @@
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
+#include "toposlam/platform/thread_os.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -52,7 +53,7 @@ void runSegment(const SegmentOptions& o) {
 
   std::unique_ptr<FrameSource> source = openSource(o.source);
   std::unique_ptr<WorkerPool> pool;
-  if (o.workers > 1) pool = std::make_unique<WorkerPool>(o.workers, "segment");
+  if (o.workers > 1) pool = std::make_unique<WorkerPool>(o.workers, namedWorkers("segment"));
   const VpackExtractor extractor(vpack, pool.get());
   const NgramSimilarity similarity(preset.similarity);
   OfflineSegmentation pipeline(extractor, similarity, config);

@@ -1,5 +1,5 @@
 // toposlamd's body; see daemon.hpp. Signals are blocked in every thread (the mask is set before any thread
-// exists, threads inherit it) and taken synchronously by the main thread with sigtimedwait(), so no work
+// exists, threads inherit it) and taken synchronously by the main thread (waitForSignal, platform/os), so no work
 // happens in a signal handler:
 //   SIGTERM, SIGINT, SIGHUP, SIGQUIT   finish the filter step in progress, save the map, exit 0
 //   SIGUSR1, SIGUSR2, SIGALRM          logged and otherwise ignored (their default would kill the daemon
@@ -7,9 +7,6 @@
 //   SIGPIPE                            ignored: a write to a closed pipe (a log reader gone) fails with
 //                                      EPIPE, which the writers treat as a failed write, not as the end
 #include "daemon.hpp"
-
-#include <signal.h>
-#include <time.h>
 
 #include <algorithm>
 #include <atomic>
@@ -38,6 +35,7 @@
 #include "toposlam/platform/lcm_transport.hpp"
 #include "toposlam/platform/signal_mask.hpp"
 #include "toposlam/platform/systemd_notifier.hpp"
+#include "toposlam/platform/thread_os.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace toposlam::daemon {
@@ -51,29 +49,11 @@ bool isStopSignal(int signal) {
   return std::find(std::begin(kStopSignals), std::end(kStopSignals), signal) != std::end(kStopSignals);
 }
 
-/// Every signal the main thread takes with sigtimedwait (stop and ignored ones).
+/// Every signal the main thread takes with waitForSignal (stop and ignored ones).
 std::vector<int> handledSignalNumbers() {
   std::vector<int> signals(std::begin(kStopSignals), std::end(kStopSignals));
   signals.insert(signals.end(), std::begin(kIgnoredSignals), std::end(kIgnoredSignals));
   return signals;
-}
-
-/// The same, as the set sigtimedwait takes.
-sigset_t handledSignals() {
-  sigset_t set;
-  sigemptyset(&set);
-  for (int s : handledSignalNumbers()) sigaddset(&set, s);
-  return set;
-}
-
-/// Waits up to `seconds` for a stop signal; returns its number or 0.
-int waitForSignal(const sigset_t& set, double seconds) {
-  timespec timeout{};
-  timeout.tv_sec = static_cast<time_t>(seconds);
-  timeout.tv_nsec = static_cast<long>((seconds - std::floor(seconds)) * 1e9);
-  siginfo_t info{};
-  const int signal = sigtimedwait(&set, &info, &timeout);
-  return signal > 0 ? signal : 0;
 }
 
 LcmChannels channelsOf(const LcmSettings& lcm) {
@@ -97,7 +77,7 @@ struct Assembly {
 
   Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri) {
     source = openSource(source_uri);
-    pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers, "tsl-vpack");
+    pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers, namedWorkers("tsl-vpack"));
     fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get());
     similarity = std::make_unique<NgramSimilarity>(config.similarity);
     segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity, 600,
@@ -111,7 +91,7 @@ struct Assembly {
 /// the network must wait for it, not exit and burn systemd's start limit. Says so in the log (at the
 /// first attempt, then once a minute) and in STATUS=; READY=1 at the first miss (started, waiting: no
 /// start timeout), watchdog pings meanwhile. False when a stop signal came first.
-bool waitForNetwork(const DaemonConfig& config, const sigset_t& signals, const SystemdNotifier& notifier,
+bool waitForNetwork(const DaemonConfig& config, const std::vector<int>& signals, const SystemdNotifier& notifier,
                     double watchdog_s, const Clock& clock) {
   const double period = config.lcm.open_retry_s;
   if (period <= 0) return true;  // no waiting: opening LCM throws with the hint (exit 1)
@@ -248,8 +228,8 @@ std::string resolveMapPath(const std::string& path) {
 }
 
 int runDaemon(const DaemonConfig& config) {
-  const sigset_t signals = handledSignals();
-  blockSignals(handledSignalNumbers());  // before any thread exists: all inherit it
+  const std::vector<int> signals = handledSignalNumbers();
+  blockSignals(signals);  // before any thread exists: all inherit it
   std::signal(SIGPIPE, SIG_IGN);                  // EPIPE instead of death on a closed log pipe
 
   SystemdNotifier notifier;

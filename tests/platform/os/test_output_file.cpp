@@ -92,3 +92,57 @@ TEST_CASE("GIVEN a disk that fills up WHEN a large file is committed THEN it thr
   CHECK(filesIn(dir) == 1);
   fs::remove_all(dir);
 }
+
+namespace {
+
+/// The system's calls, counting fsyncs and failing the n-th (1-based; 0 = none) with `error`.
+class CountingOps : public FileWriteOps {
+ public:
+  CountingOps(int fail_fsync, int error) : fail_fsync_(fail_fsync), error_(error) {}
+  int fsync(int fd) const override {
+    if (++fsyncs == fail_fsync_) {
+      errno = error_;
+      return -1;
+    }
+    return FileWriteOps::fsync(fd);
+  }
+  mutable int fsyncs = 0;
+
+ private:
+  int fail_fsync_;
+  int error_;
+};
+
+}  // namespace
+
+TEST_CASE("GIVEN an output file WHEN committed THEN the file and then its folder are fsynced, and a failed fsync is an error",
+          "[core][output][reliability]") {
+  const TempFolder temp("fsync");
+  const fs::path target = temp.path / "places.csv";
+  std::ofstream(target) << "old";
+  SECTION("both fsyncs succeed: two calls (the file, then the folder, so the rename survives a power cut)") {
+    const CountingOps ops(0, 0);
+    OutputFile out(target, &ops);
+    out << "place,node\n";
+    out.commit();
+    CHECK(ops.fsyncs == 2);
+    CHECK(readAll(target) == "place,node\n");
+    CHECK(filesIn(temp.path) == 1);
+  }
+  SECTION("the file's fsync fails (EIO): an error naming the file, the old content stays, no temporary file") {
+    const CountingOps ops(1, EIO);
+    OutputFile out(target, &ops);
+    out << "place,node\n";
+    CHECK_THROWS_WITH(out.commit(), Catch::Contains(target.string() + ": write failed: Input/output error"));
+    CHECK(readAll(target) == "old");
+    CHECK(filesIn(temp.path) == 1);
+  }
+  SECTION("the folder's fsync fails (EIO): the new file is in place and the error says it may not last") {
+    const CountingOps ops(2, EIO);
+    OutputFile out(target, &ops);
+    out << "place,node\n";
+    CHECK_THROWS_WITH(out.commit(), Catch::Contains("its folder could not be flushed"));
+    CHECK(readAll(target) == "place,node\n");
+    CHECK(filesIn(temp.path) == 1);
+  }
+}

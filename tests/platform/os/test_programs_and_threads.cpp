@@ -51,6 +51,17 @@ SCENARIO("GIVEN the calling thread WHEN its name and CPU are set THEN they hold 
   }).join();
 }
 
+SCENARIO("GIVEN namedWorkers as a pool's start hook WHEN a worker starts THEN it is named prefix-index") {
+  std::string name;
+  std::thread([&] {
+    namedWorkers("tsl-vpack")(2);
+    char buffer[32] = {};
+    REQUIRE(pthread_getname_np(pthread_self(), buffer, sizeof buffer) == 0);
+    name = buffer;
+  }).join();
+  CHECK(name == "tsl-vpack-2");
+}
+
 SCENARIO("GIVEN work done WHEN the CPU clocks are read THEN they move forward") {
   const double thread_before = threadCpuSeconds();
   const double process_before = processCpuSeconds();

@@ -6,6 +6,8 @@
 #include <signal.h>
 
 #include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <thread>
 
 #include "toposlam/platform/signal_mask.hpp"
@@ -47,4 +49,34 @@ SCENARIO(
   CHECK_FALSE(blockedHere(SIGUSR2));
   CHECK(blockSignals({SIGUSR2, 100000}) == EINVAL);
   CHECK_FALSE(blockedHere(SIGUSR2));
+}
+
+namespace {
+volatile std::sig_atomic_t g_caught = 0;
+void onSignal(int signal) { g_caught = signal; }
+}  // namespace
+
+SCENARIO("GIVEN SIGUSR1 blocked WHEN waited for THEN waitForSignal takes it when it is pending and times out when not") {
+  std::thread([] {
+    REQUIRE(blockSignals({SIGUSR1}) == 0);  // this thread only
+    const auto t0 = std::chrono::steady_clock::now();
+    CHECK(waitForSignal({SIGUSR1}, 0.05) == 0);  // nothing pending: the time runs out
+    CHECK(std::chrono::steady_clock::now() - t0 >= std::chrono::milliseconds(45));
+    REQUIRE(pthread_kill(pthread_self(), SIGUSR1) == 0);
+    CHECK(waitForSignal({SIGUSR2, SIGUSR1}, 5.0) == SIGUSR1);  // taken at once
+    CHECK(waitForSignal({SIGUSR1}, 0.0) == 0);                 // and no longer pending
+  }).join();
+}
+
+SCENARIO("GIVEN catchSignals on a blocked signal WHEN the signal comes THEN the handler runs and it is unblocked") {
+  std::thread([] {
+    REQUIRE(blockSignals({SIGUSR2}) == 0);
+    g_caught = 0;
+    REQUIRE(catchSignals({SIGUSR2}, onSignal) == 0);
+    CHECK_FALSE(blockedHere(SIGUSR2));
+    REQUIRE(pthread_kill(pthread_self(), SIGUSR2) == 0);  // delivered before pthread_kill returns
+    CHECK(g_caught == SIGUSR2);
+    CHECK(catchSignals({100000}, onSignal) == EINVAL);
+    signal(SIGUSR2, SIG_DFL);
+  }).join();
 }

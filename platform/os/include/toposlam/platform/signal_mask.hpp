@@ -1,7 +1,7 @@
-// The calling thread's signal mask: the programs block their stop signals so that no thread but the one
-// that waits for them (toposlamd's main thread with sigtimedwait, `toposlam listen`'s with a handler)
-// ever takes one. A thread starts with its creator's mask, so blocking before any thread exists blocks
-// the signals for every thread of the process. Linux/POSIX (pthread_sigmask).
+// The calling thread's signal mask, and taking signals: the programs block their stop signals so that no
+// thread but the one that waits for them (toposlamd's main thread with waitForSignal, `toposlam listen`'s
+// with catchSignals' handler) ever takes one. A thread starts with its creator's mask, so blocking before any thread exists blocks
+// the signals for every thread of the process. Linux/POSIX (pthread_sigmask, sigtimedwait, sigaction).
 //
 // Each function returns 0, or the error number the system gave (an invalid signal number: EINVAL).
 // Thread-safety: any thread; each call changes its caller's mask only.
@@ -16,5 +16,14 @@ namespace toposlam {
 int blockSignals(const std::vector<int>& signals);
 /// Removes `signals` from the calling thread's blocked set (a pending one is delivered at once).
 int unblockSignals(const std::vector<int>& signals);
+
+/// Takes one of `signals` (blocked, pending for this thread or the process) within `seconds` (sigtimedwait):
+/// returns its number, or 0 when none came in time (or the wait was interrupted by another signal).
+int waitForSignal(const std::vector<int>& signals, double seconds);
+
+/// Installs `handler` for `signals` without SA_RESTART, so a blocking call (select, read) that one of them
+/// interrupts returns EINTR and its caller can look at what the handler set; then unblocks them in the
+/// calling thread. Returns 0 or the error number.
+int catchSignals(const std::vector<int>& signals, void (*handler)(int));
 
 }  // namespace toposlam

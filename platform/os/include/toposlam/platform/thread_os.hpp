@@ -8,12 +8,15 @@
 // Thread-safety: every function may be called from any thread; it reads or changes only its caller.
 #pragma once
 
+#include <functional>
 #include <string>
 
 namespace toposlam {
 
 /// Names the calling thread (visible in top, ps -L, gdb); at most 15 characters are kept.
 int setCurrentThreadName(const std::string& name);
+/// A WorkerPool's on_thread_start that names worker i "<prefix>-<i>" (cut to 15 characters).
+std::function<void(int worker)> namedWorkers(const std::string& prefix);
 /// Pins the calling thread to CPU `cpu` (0 .. 1023).
 int pinCurrentThread(int cpu);
 /// Gives the calling thread real-time scheduling, SCHED_FIFO with `priority` (1 .. 99).
