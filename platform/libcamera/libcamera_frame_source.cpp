@@ -2,7 +2,7 @@
 // requests from libcamera's thread to the caller of next(). See the header for the contract and
 // docs/cameras.md for the design notes. Written against libcamera 0.0.3 (Debian 12); the guards on
 // TOPOSLAM_LIBCAMERA_VERSION keep it compiling with newer releases whose API moved.
-#include "toposlam/io/libcamera_frame_source.hpp"
+#include "libcamera_frame_source.hpp"
 
 #include <sys/mman.h>
 

@@ -7,7 +7,7 @@
 #include <exception>
 #include <string>
 
-#include "toposlam/io/libcamera_frame_source.hpp"
+#include "libcamera_frame_source.hpp"
 
 extern "C" __attribute__((visibility("default"))) toposlam::FrameSource* toposlam_source_libcamera_open_v1(
     const char* uri, std::string* error) {

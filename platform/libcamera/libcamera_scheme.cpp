@@ -1,5 +1,5 @@
 // Plugs `libcamera:` into the frame-source factory (openFrameSource), so every app opens cameras by URI.
-#include "toposlam/io/libcamera_frame_source.hpp"
+#include "libcamera_frame_source.hpp"
 #include "toposlam/io/source_factory.hpp"
 
 namespace toposlam {

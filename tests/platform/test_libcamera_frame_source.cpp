@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "toposlam/io/libcamera_frame_source.hpp"
+#include "libcamera_frame_source.hpp"
 #include "toposlam/io/source_factory.hpp"
 
 using toposlam::FrameSourceError;
