@@ -36,6 +36,19 @@ if command -v ffmpeg >/dev/null; then
   grep -q "file=$module " "$dest/ld.log" || fail "the installed toposlam did not load the installed video module $module"
 fi
 
+# The libcamera module likewise, when the build made one (pkg-config found libcamera): the installed
+# program loads the installed copy at the first libcamera: URI (no camera here: a clear error, exit 1).
+if [ -e "$build/modules/toposlam-source-libcamera.so" ]; then
+  module=$(find "$dest/pkg/usr/lib" -name toposlam-source-libcamera.so)
+  [ -n "$module" ] || fail "missing after install --prefix /usr: the libcamera module toposlam-source-libcamera.so"
+  rc=0
+  LD_DEBUG=files "$dest/pkg/usr/bin/toposlam" segment "libcamera:no-such-camera" --out "$dest/lc" >"$dest/ld.log" 2>&1 || rc=$?
+  [ "$rc" -eq 1 ] || { tail -5 "$dest/ld.log"; fail "the installed toposlam on a missing libcamera camera: exit $rc, expected 1"; }
+  grep -q "file=$module " "$dest/ld.log" || fail "the installed toposlam did not load the installed libcamera module $module"
+  grep -q "libcamera:no-such-camera: no camera with this ID" "$dest/ld.log" \
+    || fail "the installed toposlam did not say the libcamera camera is missing"
+fi
+
 # 2. A private prefix: everything under it, the unit pointing at its binary.
 cmake --install "$build" --prefix "$dest/local" >/dev/null
 for f in sbin/toposlamd bin/toposlam lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
