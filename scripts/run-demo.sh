@@ -29,7 +29,8 @@ source_uri="sim:office?route=loop2"
 echo "== 1/2 live: toposlamd on $source_uri, place messages over LCM"
 # The daemon and the listener share a private network namespace with multicast on loopback, so the
 # demo needs no network set-up and sends nothing outside. `--overflow block` replays the simulated
-# camera losslessly as fast as the pipeline runs (a real camera uses the default drop_oldest).
+# camera losslessly as fast as the pipeline runs; the default `auto` picks it for the simulator anyway (and
+# drop_oldest for a real camera), it is spelled out so a config file cannot change the demo.
 live_run() {
   "$toposlam" listen --channels TOPOSLAM_PLACE_EVENT,TOPOSLAM_STATUS --timeout 120 &
   listener=$!

@@ -80,6 +80,7 @@ class RateLimitedSource : public FrameSource {
     inner_->interrupt();
   }
   FrameSourceState state() const override { return inner_->state(); }
+  bool realTime() const override { return true; }  // frames come when due, not when asked for
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
   std::string frameName(std::int64_t sequence) const override { return inner_->frameName(sequence); }
@@ -122,7 +123,7 @@ std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': video: needs a file");
   const double rate = playsAtRecordedRate(uri) ? 0.0 : uri.getDouble("rate", 0.0, 1e-3, 1e4);
   using Open = FrameSource* (*)(const char*, double, std::string*);
-  const auto open = reinterpret_cast<Open>(sourceModuleSymbol("video", "toposlam_source_video_open_v1"));
+  const auto open = reinterpret_cast<Open>(sourceModuleSymbol("video", "toposlam_source_video_open_v2"));
   std::string error;
   std::unique_ptr<FrameSource> source(open(uri.path.c_str(), rate, &error));
   if (!source) throw FrameSourceError(error);
@@ -132,7 +133,7 @@ std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
 // libcamera: too (platform/libcamera): libcamera and the ~30 libraries behind it load only for a camera.
 std::unique_ptr<FrameSource> openLibcamera(const SourceUri& uri) {
   using Open = FrameSource* (*)(const char*, std::string*);
-  const auto open = reinterpret_cast<Open>(sourceModuleSymbol("libcamera", "toposlam_source_libcamera_open_v1"));
+  const auto open = reinterpret_cast<Open>(sourceModuleSymbol("libcamera", "toposlam_source_libcamera_open_v2"));
   std::string error;
   std::unique_ptr<FrameSource> source(open(uri.text.c_str(), &error));
   if (!source) throw FrameSourceError(error);

@@ -68,6 +68,7 @@ class LibcameraFrameSource : public FrameSource {
   SourceWait nextFor(std::chrono::milliseconds timeout, Frame& out) override;
   void interrupt() override;
   FrameSourceState state() const override;  ///< always streaming; `dropped` = requests re-queued unseen
+  bool realTime() const override { return true; }
   std::int64_t skippedFrames() const override;
   std::int64_t droppedFrames() const;
 

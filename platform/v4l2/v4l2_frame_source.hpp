@@ -137,6 +137,7 @@ class V4l2FrameSource : public FrameSource {
   /// Makes a blocked or future next()/nextFor() end (within poll_timeout_ms). Any thread.
   void interrupt() override;
   FrameSourceState state() const override;
+  bool realTime() const override { return true; }
   std::int64_t skippedFrames() const override;
   std::int64_t droppedFrames() const;
   V4l2SourceStatus status() const;

@@ -250,9 +250,12 @@ std::vector<ConfigKey> makeKeys() {
                       "segmentation -> topology"));
   k.push_back(integer("pipeline.queues.results", AT(pipeline.queues.results), 16, 1, 1024, "frames",
                       "topology -> publisher"));
-  k.push_back(choice("pipeline.queues.overflow", AT(pipeline.queues.overflow), QueueOverflow::DropOldest,
-                     {{"drop_oldest", QueueOverflow::DropOldest}, {"block", QueueOverflow::Block}},
-                     "drop_oldest (real time: the oldest frame is dropped and counted) or block (lossless replay)")
+  k.push_back(choice("pipeline.queues.overflow", AT(pipeline.queues.overflow), QueueOverflow::Auto,
+                     {{"auto", QueueOverflow::Auto}, {"drop_oldest", QueueOverflow::DropOldest},
+                      {"block", QueueOverflow::Block}},
+                     "auto (drop_oldest for a camera or a file played with ?rate=, block for files and the "
+                     "simulator read as fast as the pipeline goes), drop_oldest (real time: the oldest frame is "
+                     "dropped and counted) or block (lossless replay)")
                   .withOption("--overflow"));
   addThread(k, "capture", &PipelineThreads::capture, "tsl-capture");
   addThread(k, "fingerprint", &PipelineThreads::fingerprint, "tsl-fingerprint");

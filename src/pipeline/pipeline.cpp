@@ -27,7 +27,17 @@ std::string rangeError(const std::string& key, double value, const char* range) 
 }  // namespace
 
 const char* toString(QueueOverflow overflow) {
-  return overflow == QueueOverflow::Block ? "block" : "drop_oldest";
+  switch (overflow) {
+    case QueueOverflow::Auto: return "auto";
+    case QueueOverflow::Block: return "block";
+    case QueueOverflow::DropOldest: break;
+  }
+  return "drop_oldest";
+}
+
+QueueOverflow resolveOverflow(QueueOverflow configured, bool source_real_time) {
+  if (configured != QueueOverflow::Auto) return configured;
+  return source_real_time ? QueueOverflow::DropOldest : QueueOverflow::Block;
 }
 
 std::string PipelineConfig::validate() const {
@@ -133,6 +143,7 @@ Pipeline::Pipeline(const PipelineConfig& config, FrameSource& source, Fingerprin
       clock_(clock) {
   if (std::string problem = config_.validate(); !problem.empty())
     throw std::invalid_argument("pipeline." + problem);
+  config_.queues.overflow = resolveOverflow(config_.queues.overflow, source_.realTime());
   frames_ = std::make_unique<BoundedQueue<CapturedFrame>>(static_cast<std::size_t>(config_.queues.frames));
   fingerprints_ = std::make_unique<BoundedQueue<Fingerprinted>>(static_cast<std::size_t>(config_.queues.fingerprints));
   segmented_ = std::make_unique<BoundedQueue<FrameResult>>(static_cast<std::size_t>(config_.queues.segmented), carriesPlace);

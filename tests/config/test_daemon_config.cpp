@@ -104,7 +104,7 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"record: {directory: /tmp}", "unknown key 'record.directory'"},
       {"lcm: {open_retry_s: -1}", "lcm.open_retry_s: -1 is out of range, allowed [0, 3600] seconds (0 = exit 1 at once)"},
       {"log_level: verbose", "log_level: 'verbose' is not allowed, expected one of: trace, debug, info, warn, error"},
-      {"pipeline: {queues: {overflow: drop_newest}}", "pipeline.queues.overflow: 'drop_newest' is not allowed, expected one of: drop_oldest, block"},
+      {"pipeline: {queues: {overflow: drop_newest}}", "pipeline.queues.overflow: 'drop_newest' is not allowed, expected one of: auto, drop_oldest, block"},
       {"pipeline: {filter_budget_ms: 0}", "pipeline.filter_budget_ms: 0 is out of range, allowed [0.1, 1000] milliseconds"},
       {"pipeline: {status_period_s: 120}", "pipeline.status_period_s: 120 is out of range, allowed [0.1, 60] seconds"},
       {"pipeline: {thumbnail_width: 8}", "pipeline.thumbnail_width: 8 is out of range, allowed 16 .. 1280 pixels"},

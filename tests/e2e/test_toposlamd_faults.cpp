@@ -107,8 +107,9 @@ fs::path sampleFolder(const fs::path& dir, int n) {
   return frames;
 }
 
-// --overflow block: a folder plays as fast as it is read, and with the default drop_oldest a loaded machine
-// dropped one of the 3 good frames ("2 frames published, 1 dropped"); the counts here must not depend on load.
+// --overflow block: a folder plays as fast as it is read, and with drop_oldest (the default before `auto`) a
+// loaded machine dropped one of the 3 good frames ("2 frames published, 1 dropped"); `auto` picks block for a
+// folder, spelled out so the counts here never depend on the default.
 std::vector<std::string> daemonArgs(const fs::path& frames, const fs::path& map) {
   return {"--source", "images:" + frames.string(), "--map", map.string(), "--lcm-url", "memq://",
           "--overflow", "block"};

@@ -24,6 +24,7 @@ class FakeSource final : public FrameSource {
   explicit FakeSource(std::int64_t count) : count_(count) {}
   std::string describe() const override { return "fake"; }
   void interrupt() override { interrupted.store(true); }
+  bool realTime() const override { return real_time; }
   std::optional<Frame> next() override {
     if (interrupted.load()) return std::nullopt;
     if (count_ >= 0 && produced_ >= count_) {
@@ -43,6 +44,7 @@ class FakeSource final : public FrameSource {
   }
   std::function<void(std::int64_t)> before_frame;
   std::function<void()> on_end;
+  bool real_time = false;  ///< what realTime() says (a camera, a file played with ?rate=)
   std::atomic<int> released{0};
   std::atomic<bool> interrupted{false};
 

@@ -150,6 +150,53 @@ SCENARIO("A slow stage causes counted drops of the oldest frames, not growth") {
   }
 }
 
+SCENARIO("queues.overflow auto waits for a source that waits, and drops for one that runs in real time") {
+  GIVEN("200 frames from a source that is not real time (files, the simulator), a frame queue of 2 and a slow "
+        "fingerprint stage") {
+    ManualClock clock;
+    FakeSource source(200);
+    FakeFingerprint fingerprint;
+    fingerprint.on_process = [](int) { std::this_thread::sleep_for(std::chrono::microseconds(300)); };
+    FakeSegmentation segmentation(1000);
+    FakeTopology topology(clock, 1, 1e-3);
+    RecordingSink sink;
+    PipelineConfig config = losslessConfig();
+    config.queues.overflow = QueueOverflow::Auto;
+    config.queues.frames = 2;
+    Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+    pipeline.start();
+    pipeline.wait();
+    THEN("the queues block: every frame is published, none dropped") {
+      CHECK(pipeline.overflow() == QueueOverflow::Block);
+      int frames = 0;
+      for (const FrameResult& r : sink.results) frames += r.has_frame ? 1 : 0;
+      CHECK(frames == 200);
+      REQUIRE_FALSE(sink.statuses.empty());
+      CHECK(sink.statuses.back().frames_dropped == 0);
+    }
+  }
+  GIVEN("a real-time source (a camera)") {
+    ManualClock clock;
+    FakeSource source(0);
+    source.real_time = true;
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(1000);
+    FakeTopology topology(clock, 1, 1e-3);
+    RecordingSink sink;
+    PipelineConfig config = losslessConfig();
+    config.queues.overflow = QueueOverflow::Auto;
+    const Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+    config.queues.overflow = QueueOverflow::Block;
+    const Pipeline told_to_block(config, source, fingerprint, segmentation, topology, sink, clock);
+    THEN("auto drops the oldest; a configured block stays block") {
+      CHECK(pipeline.overflow() == QueueOverflow::DropOldest);
+      CHECK(told_to_block.overflow() == QueueOverflow::Block);
+      CHECK(resolveOverflow(QueueOverflow::DropOldest, false) == QueueOverflow::DropOldest);
+      CHECK(std::string(toString(QueueOverflow::Auto)) == "auto");
+    }
+  }
+}
+
 SCENARIO("requestStop() finishes the filter steps in progress and saves the map once") {
   GIVEN("an endless source, a place every 10 frames and steps of 50 slices (25 frames each)") {
     ManualClock clock;

@@ -68,6 +68,7 @@ class RecordingFrameSource final : public FrameSource {
   SourceWait nextFor(std::chrono::milliseconds timeout, Frame& out) override;
   void interrupt() override { inner_->interrupt(); }
   FrameSourceState state() const override { return inner_->state(); }
+  bool realTime() const override { return inner_->realTime(); }
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
   std::string frameName(std::int64_t sequence) const override { return inner_->frameName(sequence); }

@@ -85,6 +85,10 @@ class FrameSource {
   virtual FrameSourceState state() const { return {}; }
   /// Frames skipped because they were bad (corrupt, truncated, failed to decode).
   virtual std::int64_t skippedFrames() const { return 0; }
+  /// True when frames come at the world's pace whatever the consumer does: a camera, or a file source
+  /// played in real time (?rate=). False for files and the simulator read as fast as they are asked for.
+  /// (What a full pipeline queue does by default: drop the oldest frame, or wait; QueueOverflow::Auto.)
+  virtual bool realTime() const { return false; }
   /// Total frames if known in advance (files), else -1 (cameras).
   virtual std::int64_t frameCountHint() const { return -1; }
   /// The name of frame `sequence` when the source can tell it without reading the frame (files: the file

@@ -42,15 +42,20 @@
 
 namespace toposlam {
 
-enum class QueueOverflow { DropOldest, Block };
+/// What a full queue does. Auto: DropOldest for a source that runs in real time (a camera, a file played
+/// with ?rate=, FrameSource::realTime()), Block for one that does not (files and the simulator played as
+/// fast as the pipeline goes: dropping their frames would only lose them).
+enum class QueueOverflow { Auto, DropOldest, Block };
 const char* toString(QueueOverflow overflow);
+/// Auto resolved for a source that is (or is not) real time; the other values unchanged.
+QueueOverflow resolveOverflow(QueueOverflow configured, bool source_real_time);
 
 struct PipelineQueues {
   int frames = 2;         ///< capture -> fingerprint (frames hold camera buffers: keep small)
   int fingerprints = 8;   ///< fingerprint -> segmentation
   int segmented = 8;      ///< segmentation -> topology
   int results = 16;       ///< topology -> publisher
-  QueueOverflow overflow = QueueOverflow::DropOldest;
+  QueueOverflow overflow = QueueOverflow::Auto;
 };
 
 struct PipelineThreads {
@@ -123,6 +128,8 @@ class Pipeline {
   std::vector<std::string> warnings() const { return threads_.warnings(); }
   /// Error that ended a stage thread ("" if none); the daemon exits non-zero on it.
   std::string error() const;
+  /// What a full queue does in this run: queues.overflow with Auto resolved for the source.
+  QueueOverflow overflow() const { return config_.queues.overflow; }
 
  private:
   struct CapturedFrame;

@@ -308,6 +308,10 @@ int runDaemon(const DaemonConfig& config) {
 
   Pipeline pipeline(pipeline_config, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink,
                     clock);
+  if (pipeline_config.queues.overflow == QueueOverflow::Auto)
+    spdlog::info("toposlamd: full queues {} (pipeline.queues.overflow auto: {})", toString(pipeline.overflow()),
+                 parts.source->realTime() ? "the source runs in real time, so the oldest frame is dropped and counted"
+                                          : "the source waits for the pipeline, so every frame is processed");
   ThreadTable io_threads;
   // Whatever ends this function, the I/O threads are told to end before the table joins them.
   struct EndIoThreads {
