@@ -18,9 +18,13 @@ AtomicFileWrite::AtomicFileWrite(std::filesystem::path target, std::string infix
       folder_(target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".")),
       infix_(std::move(infix)) {}
 
-AtomicFileWrite::~AtomicFileWrite() {
+AtomicFileWrite::~AtomicFileWrite() { discard(); }
+
+void AtomicFileWrite::discard() {
   if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
   if (!replaced_ && !temporary_.empty()) ::unlink(temporary_.c_str());
+  if (!replaced_) temporary_.clear();
 }
 
 int AtomicFileWrite::create() {
@@ -54,6 +58,7 @@ int AtomicFileWrite::sync(const FileWriteOps& ops) { return ops.fsync(fd_) != 0 
 int AtomicFileWrite::close() {
   const int fd = fd_;
   fd_ = -1;
+  if (fd < 0) return 0;  // closed already
   return ::close(fd) != 0 ? errno : 0;
 }
 

@@ -110,33 +110,31 @@ OutputFile::~OutputFile() {
   atomic_.reset();  // not committed: closes and removes the temporary file
 }
 
+void OutputFile::failCommit(const std::string& message) {
+  // The AtomicFileWrite stays (the buffer points at it); its temporary file goes now, so a caller that
+  // catches the error sees the folder as it was. A later commit() throws the same message again.
+  if (atomic_ != nullptr) atomic_->discard();
+  failure_ = message;
+  setstate(std::ios::badbit);
+  throw OutputFileError(failure_);
+}
+
 void OutputFile::commit() {
   if (committed_) return;
+  if (!failure_.empty()) throw OutputFileError(failure_);
   flush();
   bool ok = buffer_->drain() && !fail();
   if (!ok && buffer_->error() == 0) buffer_->fail(EIO);  // a formatting failure inside the stream
   ok = buffer_->close() && ok;
-  if (!ok) {
-    const std::string reason = std::strerror(buffer_->error());
-    const bool replaced_nothing = atomic_ != nullptr;
-    atomic_.reset();  // removes the temporary file
-    setstate(std::ios::badbit);
-    throw OutputFileError(target_.string() + ": write failed: " + reason +
-                          (replaced_nothing ? " (the file was not written)" : ""));
-  }
+  if (!ok)
+    failCommit(target_.string() + ": write failed: " + std::strerror(buffer_->error()) +
+               (atomic_ != nullptr ? " (the file was not written)" : ""));
   if (atomic_ != nullptr) {
-    if (const int error = atomic_->replaceTarget(); error != 0) {
-      atomic_.reset();
-      setstate(std::ios::badbit);
-      throw OutputFileError(target_.string() + ": cannot replace it: " + std::strerror(error));
-    }
-    const int error = atomic_->syncFolder(buffer_->ops());
-    atomic_.reset();
-    if (error != 0) {
-      setstate(std::ios::badbit);
-      throw OutputFileError(target_.string() + ": written, but its folder could not be flushed (the new file may "
-                            "not survive a power cut): " + std::strerror(error));
-    }
+    if (const int error = atomic_->replaceTarget(); error != 0)
+      failCommit(target_.string() + ": cannot replace it: " + std::strerror(error));
+    if (const int error = atomic_->syncFolder(buffer_->ops()); error != 0)
+      failCommit(target_.string() + ": written, but its folder could not be flushed (the new file may not survive a "
+                 "power cut): " + std::strerror(error));
   }
   committed_ = true;
 }

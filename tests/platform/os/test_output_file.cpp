@@ -136,6 +136,10 @@ TEST_CASE("GIVEN an output file WHEN committed THEN the file and then its folder
     CHECK_THROWS_WITH(out.commit(), Catch::Contains(target.string() + ": write failed: Input/output error"));
     CHECK(readAll(target) == "old");
     CHECK(filesIn(temp.path) == 1);
+    // Committing again says the same, and touches nothing (the temporary file is gone already).
+    CHECK_THROWS_WITH(out.commit(), Catch::Contains(target.string() + ": write failed: Input/output error"));
+    CHECK(ops.fsyncs == 1);
+    CHECK(readAll(target) == "old");
   }
   SECTION("the folder's fsync fails (EIO): the new file is in place and the error says it may not last") {
     const CountingOps ops(2, EIO);
@@ -144,5 +148,8 @@ TEST_CASE("GIVEN an output file WHEN committed THEN the file and then its folder
     CHECK_THROWS_WITH(out.commit(), Catch::Contains("its folder could not be flushed"));
     CHECK(readAll(target) == "place,node\n");
     CHECK(filesIn(temp.path) == 1);
+    CHECK_THROWS_WITH(out.commit(), Catch::Contains("its folder could not be flushed"));
+    CHECK(ops.fsyncs == 2);
+    CHECK(readAll(target) == "place,node\n");
   }
 }

@@ -47,6 +47,9 @@ class AtomicFileWrite {
   int close();
   /// Renames the temporary file over the target; from then on the temporary file is the target.
   int replaceTarget();
+  /// Closes and removes the temporary file now (after a failed step; replaceTarget() not done yet).
+  /// Idempotent; the destructor does it too.
+  void discard();
   /// fsync of the target's folder, so that the rename is on disk. A folder that cannot be opened, or a
   /// file system that cannot sync folders (EINVAL), counts as done (0).
   int syncFolder(const FileWriteOps& ops) const;

@@ -33,13 +33,16 @@ class OutputFile : public std::ostream {
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
 
-  /// Flushes, checks, fsyncs and renames over the target. Throws OutputFileError; idempotent.
+  /// Flushes, checks, fsyncs and renames over the target. Throws OutputFileError; idempotent (once it
+  /// has thrown, it throws the same error again).
   void commit();
   const std::filesystem::path& target() const { return target_; }
 
  private:
   class Buffer;
+  [[noreturn]] void failCommit(const std::string& message);
   std::filesystem::path target_;
+  std::string failure_;  ///< what the commit that failed said
   std::unique_ptr<AtomicFileWrite> atomic_;  ///< null when writing in place (not a regular file)
   std::unique_ptr<Buffer> buffer_;
   bool committed_ = false;
