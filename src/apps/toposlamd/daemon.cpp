@@ -10,8 +10,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
-#include <cmath>
 #include <csignal>
 #include <iterator>
 #include <cstdio>
@@ -310,8 +308,9 @@ int runDaemon(const DaemonConfig& config) {
                     clock);
   if (pipeline_config.queues.overflow == QueueOverflow::Auto)
     spdlog::info("toposlamd: full queues {} (pipeline.queues.overflow auto: {})", toString(pipeline.overflow()),
-                 parts.source->realTime() ? "the source runs in real time, so the oldest frame is dropped and counted"
-                                          : "the source waits for the pipeline, so every frame is processed");
+                 pipeline.overflow() == QueueOverflow::Block
+                     ? "the source waits for the pipeline, so every frame is processed"
+                     : "the source runs in real time, so the oldest frame is dropped and counted");
   ThreadTable io_threads;
   // Whatever ends this function, the I/O threads are told to end before the table joins them.
   struct EndIoThreads {
