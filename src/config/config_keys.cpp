@@ -417,6 +417,9 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(choice("segmentation.cut_placement", AT(segmentation.cut_placement), CutPlacement::WindowSplit,
                      {{"window-split", CutPlacement::WindowSplit}, {"valley-frame", CutPlacement::ValleyFrame}},
                      "where a place ends: the best split of the valley's window, or the valley frame (thesis)"));
+  k.push_back(real("segmentation.doorway_shift_s", AT(segmentation.doorway_shift_s), 7.0, 0, 60, "seconds",
+                   "a border moves to the doorway passage nearest it (predicted from the vertical edges) when one is "
+                   "at most this far (0 = off, the thesis)"));
   k.push_back(choice("segmentation.representative", AT(segmentation.representative), RepresentativeChoice::WindowDegree,
                      {{"window-degree", RepresentativeChoice::WindowDegree},
                       {"place-medoid", RepresentativeChoice::PlaceMedoid}},

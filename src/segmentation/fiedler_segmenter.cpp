@@ -95,6 +95,7 @@ std::string FiedlerSegmenterConfig::validate() const {
   if (auto p = outside("min_frame_spacing_m", min_frame_spacing_m, 0, 100, " m", " (0 = off)")) return *p;
   if (auto p = outside("representative_interval_s", representative_interval_s, 0, 3600, " s", " (0 = every frame)")) return *p;
   if (auto p = outside("min_frame_spacing_rad", min_frame_spacing_rad, 0, 10, " rad", "")) return *p;
+  if (auto p = outside("doorway_shift_s", doorway_shift_s, 0, 60, " s", " (0 = off)")) return *p;
   if (min_window_frames < 3 || min_window_frames > window) {
     return "min_window_frames: " + std::to_string(min_window_frames) + " is outside the allowed range [3, window = " +
            std::to_string(window) + "]";
@@ -152,6 +153,13 @@ FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const S
   inv_sqrt_degree_ = Eigen::VectorXd::Zero(n);
   laplacian_ = Eigen::MatrixXd::Zero(n, n);
   candidates_.reserve(static_cast<std::size_t>(4 * n));
+  if (config_.doorway_shift_s > 0.0) {
+    // A border is at most a window (plus the valley's confirmation) old; frames older than this ring
+    // cannot take a moved border.
+    const auto recent = static_cast<std::size_t>(4 * n + 64);
+    recent_frame_.assign(recent, -1);
+    recent_time_.assign(recent, 0.0);
+  }
   if (config_.representative == RepresentativeChoice::PlaceMedoid) {
     place_samples_.reserve(FiedlerSegmenterConfig::kMaxPlaceSamples);
     place_sample_affinity_ = Eigen::MatrixXd::Zero(FiedlerSegmenterConfig::kMaxPlaceSamples,
@@ -452,6 +460,14 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
     place_start_ = frame_index;
     place_start_time_s_ = time_s;
   }
+  if (config_.doorway_shift_s > 0.0) {
+    const Fingerprint& added = *slot_fingerprint_[s];
+    doorway_.addFrame(time_s, added.image_width, added.edge_columns);
+    recent_frame_[recent_next_] = frame_index;
+    recent_time_[recent_next_] = time_s;
+    recent_next_ = (recent_next_ + 1) % recent_frame_.size();
+    recent_count_ = std::min(recent_count_ + 1, recent_frame_.size());
+  }
 
   SegmenterStep step;
   step.frame = frame_index;
@@ -490,6 +506,7 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
     }
     if (valley) {
       if (pending_min_frame_ == *valley && pending_border_frame_ > place_start_) {
+        if (config_.doorway_shift_s > 0.0) moveBorderToDoorway();
         step.closed_place = closePlace(*valley, pending_border_frame_, pending_border_time_s_);
       } else {
         ++ignored_valleys_;
@@ -501,6 +518,52 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
   return step;
 }
 
+void FiedlerSegmenter::moveBorderToDoorway() {
+  const std::optional<double> passage = doorway_.nearestPassage(pending_border_time_s_, config_.doorway_shift_s);
+  if (!passage) return;
+  // The first recent frame at or after the passage, and the one before it (the closing place's last).
+  // A passage still ahead (predicted less than a second before the robot gets there) takes the newest
+  // frame: a place cannot start at a frame not seen yet.
+  const std::size_t size = recent_frame_.size();
+  const std::size_t oldest = recent_count_ < size ? 0 : recent_next_;
+  std::int64_t border = -1, last = -1;
+  double border_time = 0.0, last_time = 0.0;
+  for (std::size_t k = 0; k < recent_count_; ++k) {
+    const std::size_t i = (oldest + k) % size;
+    if (recent_time_[i] >= *passage) {
+      border = recent_frame_[i];
+      border_time = recent_time_[i];
+      break;
+    }
+    last = recent_frame_[i];
+    last_time = recent_time_[i];
+  }
+  if (border < 0 && recent_count_ >= 2) {
+    const std::size_t newest = (recent_next_ + size - 1) % size;
+    const std::size_t before = (recent_next_ + size - 2) % size;
+    border = recent_frame_[newest];
+    border_time = recent_time_[newest];
+    last = recent_frame_[before];
+    last_time = recent_time_[before];
+  }
+  if (border < 0 || last < 0 || border <= place_start_ || border == pending_border_frame_) return;
+  const std::int64_t from = std::max(place_start_, representative_from_);
+  const std::int64_t to = std::min(pending_last_frame_, last);
+  const bool has_candidate = std::any_of(candidates_.begin(), candidates_.end(), [&](const Candidate& c) {
+    return c.frame >= from && c.frame <= to;
+  });
+  if (!has_candidate) return;
+  // The representatives stay within the borders found by appearance: the frames a shift moves into a
+  // place look like its neighbour (the room seen through the door, the corridor seen on the way out).
+  representative_last_ = std::min(pending_last_frame_, last);
+  next_representative_from_ = std::max(border, pending_border_frame_);
+  pending_border_frame_ = border;
+  pending_border_time_s_ = border_time;
+  pending_last_frame_ = last;
+  pending_last_time_s_ = last_time;
+  ++doorway_shifts_;
+}
+
 SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
                                             double next_start_time_s) {
   SegmentedPlace place;
@@ -510,10 +573,14 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
   place.last_time_s = valley_frame < 0 ? last_time_s_ : pending_last_time_s_;
   place.valley_frame = valley_frame;
   const std::int64_t last_frame = place.last_frame;
+  // Representative candidates: the place's frames, within the borders found by appearance when a
+  // border was moved to a doorway (moveBorderToDoorway).
+  const std::int64_t candidates_from = std::max(place_start_, representative_from_);
+  const std::int64_t candidates_to = std::min(last_frame, representative_last_);
 
   const Candidate* best = nullptr;
   for (const Candidate& c : candidates_) {
-    if (c.frame < place_start_ || c.frame > last_frame) continue;
+    if (c.frame < candidates_from || c.frame > candidates_to) continue;
     if (best == nullptr || preferred(c, *best)) best = &c;
   }
   if (config_.representative == RepresentativeChoice::PlaceMedoid) {
@@ -542,6 +609,9 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
   place.index = place.dropped ? dropped_places_++ : kept_places_++;
 
   std::erase_if(candidates_, [&](const Candidate& c) { return c.frame <= last_frame; });
+  representative_from_ = next_representative_from_;
+  representative_last_ = std::numeric_limits<std::int64_t>::max();
+  next_representative_from_ = -1;
   place_start_ = next_start_frame;
   place_start_time_s_ = next_start_time_s;
   return place;

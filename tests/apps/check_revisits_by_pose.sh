@@ -22,7 +22,9 @@ dn = json.load(open(sys.argv[2]))["place_revisits"]
 for name, v in (("two laps", two), ("day then night", dn)):
     print("%s: %d of %d revisits closed right, %d missed, %d wrong closures"
           % (name, v["closed_right"], v["revisits"], v["missed"], v["wrong_closures"]))
-ok = two["revisits"] == 12 and two["closed_right"] >= 10 and two["wrong_closures"] == 0
+# Issue 14's target: at least 90 % of the second lap's revisits closed right, none wrong. The count of
+# revisits follows the place borders (12 with borders by appearance, 13 with borders at doorways).
+ok = 11 <= two["revisits"] <= 14 and 10 * two["closed_right"] >= 9 * two["revisits"] and two["wrong_closures"] == 0
 ok = ok and dn["revisits"] >= 10 and 2 * dn["closed_right"] >= dn["revisits"] and dn["wrong_closures"] == 0
 sys.exit(0 if ok else 1)
 PY

@@ -52,6 +52,7 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/segmentation/doorway_passage.hpp"
 #include "toposlam/segmentation/motion_gate.hpp"
 #include "toposlam/segmentation/valley_detector.hpp"
 
@@ -107,6 +108,10 @@ struct FiedlerSegmenterConfig {
   ValleyDetectorConfig valley{0.5, 0.30};
   int min_keypoints = 15;  ///< places whose representative has fewer keypoints are dropped (thesis: 15)
   CutPlacement cut_placement = CutPlacement::WindowSplit;
+  /// Borders at doorways (docs/segmentation.md, "Borders at doorways"): a border found by appearance
+  /// moves to the doorway passage (DoorwayPassageDetector, from the frames' vertical edges) nearest to
+  /// it when one is at most this many seconds away. Allowed [0, 60]; 0 = off (the thesis).
+  double doorway_shift_s = 0.0;
   /// The representative rule; both prefer frames with at least min_keypoints keypoints.
   RepresentativeChoice representative = RepresentativeChoice::WindowDegree;
   /// PlaceMedoid: the place's frames are sampled at most this often (its first frame always; allowed
@@ -183,6 +188,9 @@ class FiedlerSegmenter {
   std::int64_t skippedFrames() const { return skipped_frames_; }
   /// Frames left out as too close (min_frame_spacing_m / _rad) to the last frame added.
   std::int64_t thinnedFrames() const { return thinned_frames_; }
+  /// Borders moved to a doorway passage (doorway_shift_s), and doorway passages seen.
+  std::int64_t doorwayShifts() const { return doorway_shifts_; }
+  std::int64_t doorwayPassages() const { return doorway_.passageCount(); }
   /// Current cached affinity matrix, rows/columns in window order (oldest first); for tests and plots.
   Eigen::MatrixXd affinityInWindowOrder() const;
 
@@ -220,6 +228,9 @@ class FiedlerSegmenter {
   std::optional<std::pair<int, double>> placeMedoid(int count) const;
   /// PlaceMedoid: forgets the first `count` samples (a closed place's).
   void dropPlaceSamples(int count);
+  /// doorway_shift_s: moves the pending border to the doorway passage nearest to it, when there is one
+  /// and the border stays inside (place start, newest frame] with a representative candidate before it.
+  void moveBorderToDoorway();
   /// Closes the open place: at the pending border (valley_frame >= 0) or at the newest frame (-1).
   SegmentedPlace closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
                             double next_start_time_s);
@@ -269,6 +280,19 @@ class FiedlerSegmenter {
   std::int64_t ignored_valleys_ = 0;
   std::int64_t skipped_frames_ = 0;
   std::int64_t thinned_frames_ = 0;
+  // doorway_shift_s: the passages, and the recent frames (ring, oldest at recent_next_ once full) to
+  // find the frame a passage time falls on.
+  DoorwayPassageDetector doorway_;
+  std::vector<std::int64_t> recent_frame_;
+  std::vector<double> recent_time_;
+  std::size_t recent_next_ = 0;
+  std::size_t recent_count_ = 0;
+  std::int64_t doorway_shifts_ = 0;
+  // After a doorway shift, the representative is chosen among frames inside the borders found by
+  // appearance: [representative_from_, representative_last_] of the open place.
+  std::int64_t representative_from_ = -1;
+  std::int64_t representative_last_ = std::numeric_limits<std::int64_t>::max();
+  std::int64_t next_representative_from_ = -1;
 };
 
 }  // namespace toposlam

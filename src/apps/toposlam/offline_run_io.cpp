@@ -64,7 +64,7 @@ void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::
 }
 
 namespace {
-enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kRepresentative, kRepresentativeInterval };
+enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kDoorwayShift, kRepresentative, kRepresentativeInterval };
 }  // namespace
 
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
@@ -114,6 +114,12 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
                          ->capture_default_str()
                          ->check(CLI::IsMember({"window-split", "valley-frame"})),
                      kCut);
+  given.emplace_back(command.add_option("--doorway-shift-s", c.doorway_shift_s,
+                                        "Segmentation: move a border to the doorway passage nearest it (seen in the "
+                                        "vertical edges) when one is at most this many seconds away (0 = off)")
+                         ->capture_default_str()
+                         ->check(keyRange("segmentation.doorway_shift_s")),
+                     kDoorwayShift);
   given.emplace_back(command.add_option("--representative", options.representative,
                                         "Segmentation: a place's representative: window-degree (the thesis) or "
                                         "place-medoid (the sampled frame most like the place's others)")
@@ -149,6 +155,7 @@ FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const
       case kFloor: config.similarity_floor = o.similarity_floor; break;
       case kMinKeypoints: config.min_keypoints = o.min_keypoints; break;
       case kCut: config.cut_placement = parseCutPlacement(options.cut); break;
+      case kDoorwayShift: config.doorway_shift_s = o.doorway_shift_s; break;
       case kRepresentative: config.representative = parseRepresentativeChoice(options.representative); break;
       case kRepresentativeInterval: config.representative_interval_s = o.representative_interval_s; break;
     }

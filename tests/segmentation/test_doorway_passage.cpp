@@ -1,0 +1,217 @@
+// DoorwayPassageDetector (the jambs' time to contact) and FiedlerSegmenter's borders moved to a
+// doorway passage, on synthetic edge streams made from a pinhole camera driving through a door.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fake_similarity.hpp"
+#include "toposlam/segmentation/doorway_passage.hpp"
+#include "toposlam/segmentation/fiedler_segmenter.hpp"
+
+using toposlam::DoorwayPassageConfig;
+using toposlam::DoorwayPassageDetector;
+using toposlam::FiedlerSegmenter;
+using toposlam::FiedlerSegmenterConfig;
+using toposlam::Fingerprint;
+using toposlam::SegmentedPlace;
+
+namespace {
+
+constexpr int kWidth = 320;
+const double kFocalPx = 160.0 / std::tan(0.5 * 1.05);  // a 60-degree horizontal field of view
+
+/// Columns of vertical edges at lateral offsets `lateral_m` (negative = left) and depth `depth_m`, seen
+/// by a camera looking along the depth axis; edges outside the image are not seen.
+std::vector<int> edgesAt(const std::vector<double>& lateral_m, double depth_m) {
+  std::vector<int> columns;
+  if (depth_m <= 0.0) return columns;
+  for (const double a : lateral_m) {
+    const double x = 160.0 + kFocalPx * a / depth_m;
+    if (x >= 0.0 && x < kWidth) columns.push_back(static_cast<int>(std::lround(std::floor(x))));
+  }
+  std::sort(columns.begin(), columns.end());
+  return columns;
+}
+
+/// Drives at `speed` m/s through a door whose jambs are at `jambs` (lateral, m) and reached at
+/// `passage_s`, from `start_s` to `end_s` at `fps`; extra edges far away sit near the centre.
+void driveThroughDoor(DoorwayPassageDetector& detector, double fps, double start_s, double end_s, double passage_s,
+                      std::vector<double> jambs = {-0.45, -0.40, 0.40, 0.45}, double speed = 0.5) {
+  for (int k = 0;; ++k) {
+    const double t = start_s + k / fps;
+    if (t > end_s) break;
+    const double depth = speed * (passage_s - t);
+    std::vector<int> columns = edgesAt(jambs, depth);
+    // A far wall's edges, 6 m beyond the door: they drift out slowly and never leave the image.
+    for (const int c : edgesAt({-1.0, 1.2}, depth + 6.0)) columns.push_back(c);
+    std::sort(columns.begin(), columns.end());
+    detector.addFrame(t, kWidth, columns);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a camera driving through a doorway WHEN its edges are tracked THEN the passage is predicted",
+          "[segmentation][doorway]") {
+  for (const double fps : {2.0, 5.0, 15.0, 30.0}) {
+    INFO("fps " << fps);
+    DoorwayPassageDetector detector;
+    driveThroughDoor(detector, fps, 0.0, 9.0, 6.0);
+    CHECK(detector.passageCount() == 1);
+    const std::optional<double> passage = detector.nearestPassage(6.0, 3.0);
+    REQUIRE(passage.has_value());
+    CHECK(*passage == Approx(6.0).margin(0.25));
+    CHECK_FALSE(detector.nearestPassage(1.0, 3.0).has_value());  // further than 3 s from it
+  }
+  SECTION("5 cm off the door's axis, the jambs leave the view 0.35 s apart and still agree") {
+    DoorwayPassageDetector detector;
+    driveThroughDoor(detector, 5.0, 0.0, 9.0, 6.0, {-0.42, -0.37, 0.47, 0.52});
+    const std::optional<double> passage = detector.nearestPassage(6.0, 3.0);
+    REQUIRE(passage.has_value());
+    CHECK(*passage == Approx(6.0).margin(0.3));
+  }
+}
+
+TEST_CASE("GIVEN edge motions that are no doorway WHEN tracked THEN no passage is recorded",
+          "[segmentation][doorway]") {
+  DoorwayPassageDetector detector;
+  SECTION("one wall only: edges leave on the left side alone") {
+    driveThroughDoor(detector, 5.0, 0.0, 9.0, 6.0, {-0.45, -0.40});
+  }
+  SECTION("turning on the spot: every edge sweeps the same way, out on one side and in on the other") {
+    for (int k = 0; k < 40; ++k) {
+      std::vector<int> columns;
+      for (int c = 20 + 9 * k % 60; c < kWidth; c += 60) columns.push_back(c);
+      detector.addFrame(0.2 * k, kWidth, columns);
+    }
+  }
+  SECTION("standing still in front of a doorway: the jambs stay where they are") {
+    for (int k = 0; k < 40; ++k) detector.addFrame(0.2 * k, kWidth, {30, 40, 280, 290});
+  }
+  SECTION("the two sides leave two seconds apart (two different things, not one doorway)") {
+    driveThroughDoor(detector, 5.0, 0.0, 5.0, 6.0, {-0.45, -0.40});
+    driveThroughDoor(detector, 5.0, 5.2, 12.0, 8.0, {0.40, 0.45});
+  }
+  CHECK(detector.passageCount() == 0);
+  CHECK_FALSE(detector.nearestPassage(6.0, 60.0).has_value());
+}
+
+TEST_CASE("GIVEN a clock that goes back WHEN frames arrive THEN the passages before are forgotten",
+          "[segmentation][doorway]") {
+  DoorwayPassageDetector detector;
+  driveThroughDoor(detector, 5.0, 0.0, 9.0, 6.0);
+  REQUIRE(detector.nearestPassage(6.0, 1.0).has_value());
+  detector.addFrame(0.0, kWidth, {});  // a new traversal
+  CHECK_FALSE(detector.nearestPassage(6.0, 1.0).has_value());
+  CHECK(detector.passageCount() == 1);
+}
+
+TEST_CASE("GIVEN bad doorway settings WHEN a detector is made THEN they are refused by name",
+          "[segmentation][doorway]") {
+  DoorwayPassageConfig config;
+  CHECK(config.validate().empty());
+  SECTION("fit_s") { config.fit_s = 0.0; }
+  SECTION("border_fraction") { config.border_fraction = 1.5; }
+  SECTION("max_lookahead_s") { config.max_lookahead_s = 0.0; }
+  SECTION("max_exit_gap_s") { config.max_exit_gap_s = -1.0; }
+  const std::string problem = config.validate();
+  CHECK_FALSE(problem.empty());
+  CHECK_THROWS_WITH(DoorwayPassageDetector(config), Catch::Contains("doorway passage config: ") &&
+                                                        Catch::Contains(problem.substr(0, problem.find(':'))));
+  FiedlerSegmenterConfig segmenter;
+  segmenter.doorway_shift_s = 61.0;
+  CHECK_THAT(segmenter.validate(), Catch::Contains("doorway_shift_s"));
+}
+
+namespace {
+
+/// Frame f: id f in image_height (the table's key), a 320-pixel-wide image, and the edges of a door
+/// passed at frame `door_frame` (jambs 0.45 m either side, 0.5 m/s at 5 fps); no door when negative.
+std::shared_ptr<const Fingerprint> doorFrame(int f, int door_frame) {
+  auto fingerprint = std::make_shared<Fingerprint>();
+  fingerprint->image_width = kWidth;
+  fingerprint->image_height = f;
+  fingerprint->keypoints.resize(50);
+  if (door_frame >= 0) fingerprint->edge_columns = edgesAt({-0.45, -0.40, 0.40, 0.45}, 0.1 * (door_frame - f));
+  return fingerprint;
+}
+
+class HeightTable : public toposlam::SimilarityMeasure {
+ public:
+  explicit HeightTable(std::function<double(int, int)> table) : table_(std::move(table)) {}
+  double similarity(const Fingerprint& reference, const Fingerprint& query) const override {
+    return table_(reference.image_height, query.image_height);
+  }
+
+ private:
+  std::function<double(int, int)> table_;
+};
+
+/// Two blocks by appearance (frames 0-39 and 40-99), a door passed at `door_frame`.
+std::vector<SegmentedPlace> segmentWithDoor(double shift_s, int door_frame, FiedlerSegmenter** out = nullptr) {
+  // Frames 40-44, just past the appearance border, look like everything around (the room through
+  // the door, seen from the corridor): the largest degree of any window, a bad representative.
+  static const HeightTable similarity([](int a, int b) {
+    const auto doorway_view = [](int f) { return f >= 40 && f < 45; };
+    if (doorway_view(a) || doorway_view(b)) return 0.97;
+    if ((a < 40) != (b < 40)) return 0.05;
+    return 0.9 + 0.05 * std::sin(0.7 * a + 1.3 * b);
+  });
+  FiedlerSegmenterConfig config = toposlam::test::thesisConfig();
+  config.doorway_shift_s = shift_s;
+  static std::unique_ptr<FiedlerSegmenter> keep;
+  keep = std::make_unique<FiedlerSegmenter>(config, similarity);
+  std::vector<SegmentedPlace> places;
+  for (int f = 0; f < 100; ++f) {
+    if (auto step = keep->addFrame(f, 0.2 * f, doorFrame(f, door_frame)); step.closed_place)
+      places.push_back(*step.closed_place);
+  }
+  if (auto last = keep->flush()) places.push_back(*last);
+  if (out != nullptr) *out = keep.get();
+  return places;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a border by appearance near a doorway passage WHEN segmented THEN the border moves to the door",
+          "[segmentation][doorway]") {
+  FiedlerSegmenter* segmenter = nullptr;
+  SECTION("off (the thesis): the border is where the appearance changes") {
+    const auto places = segmentWithDoor(0.0, 50, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == 40);
+    CHECK(segmenter->doorwayShifts() == 0);
+  }
+  SECTION("the door 10 frames (2 s) after the appearance border: the place ends at the door") {
+    const auto places = segmentWithDoor(7.0, 50, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(50).margin(1));
+    CHECK(places[0].last_frame == places[1].first_frame - 1);
+    CHECK(segmenter->doorwayShifts() == 1);
+    THEN("the representatives stay inside the borders found by appearance") {
+      CHECK(places[0].representative_frame < 40);
+      CHECK(places[1].representative_frame >= 40);
+    }
+  }
+  SECTION("the door 8 frames before the appearance border: the place ends at the door") {
+    const auto places = segmentWithDoor(7.0, 32, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(32).margin(1));
+    CHECK(places[0].representative_frame < 32);
+    CHECK(places[1].representative_frame >= 40);
+  }
+  SECTION("a door further away than doorway_shift_s: the border stays") {
+    const auto places = segmentWithDoor(1.0, 50, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == 40);
+    CHECK(segmenter->doorwayPassages() == 1);
+    CHECK(segmenter->doorwayShifts() == 0);
+  }
+}
