@@ -250,7 +250,7 @@ class TopologyParticleFilter {
                                                            const SimilarityMeasure& similarity);
 
  private:
-  enum class Phase : std::uint8_t { Idle, Collect, Similarity, Aggregate, Propose, Resample, Update };
+  enum class Phase : std::uint8_t { Idle, Collect, Propose, Similarity, Aggregate, Resample, Update };
   using StatePtr = std::shared_ptr<const topology_detail::TopologyState>;
 
   double uniform01();
