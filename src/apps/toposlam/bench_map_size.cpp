@@ -13,7 +13,8 @@
 // fork takes the same step exhaustively: the decision (the founding observation of the most probable
 // current node over the particles) is compared with the indexed step's, over all compared steps and over
 // those where the exhaustive filter has decided (its most probable node has p >= 0.5). Timings are the indexed filter's steps only; RSS is the
-// process's (VmRSS) at each checkpoint. Prints numbers (and an SVG with --svg), fails nothing.
+// process's (VmRSS) at each checkpoint; "compared" is the mean number of exact similarity evaluations per
+// step. Prints numbers (and an SVG with --svg), fails nothing.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
