@@ -482,9 +482,9 @@ std::vector<ConfigKey> makeKeys() {
                       1000000000, "representatives",
                       "compare a new place with every stored representative up to this many; above, through the "
                       "candidate index"));
-  k.push_back(integer("topology.candidates.candidates", AT(topology.candidates.candidates), 200, 1, 100000,
+  k.push_back(integer("topology.candidates.candidates", AT(topology.candidates.candidates), 100, 1, 100000,
                       "representatives", "compared exactly from the index's top"));
-  k.push_back(integer("topology.candidates.background_samples", AT(topology.candidates.background_samples), 300, 0,
+  k.push_back(integer("topology.candidates.background_samples", AT(topology.candidates.background_samples), 100, 0,
                       100000, "representatives",
                       "evenly spread stored representatives also compared exactly, for the others' statistics"));
   k.push_back(integer("topology.slice_items", AT(topology_stage.slice_items), 256, 1, 1000000, "work items",

@@ -282,8 +282,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
             fingerprints_[o].reset();  // no particle refers to it any more: forget it
           }
         }
-        selectComparisons();
-        phase_ = Phase::Similarity;
+        phase_ = Phase::Propose;
         cursor_ = 0;
         break;
       case Phase::Similarity:
@@ -313,7 +312,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           stats.new_likelihood =
               entropyFromSums(root.memo_sum, root.memo_sum_l_log_l, g.nodeCount()) * (1.0 - stats.max);
         }
-        phase_ = Phase::Propose;
+        phase_ = Phase::Resample;
         cursor_ = 0;
         break;
       case Phase::Propose:
@@ -351,14 +350,19 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
             }
           }
           proposal_[cursor_] = next;
-          weight_[cursor_] = next == n ? group_stats_[g].new_likelihood
-                                       : entryLikelihood(state.nodes.get(next), similarity_of_);
         }
-        phase_ = Phase::Resample;
+        selectComparisons();
+        phase_ = Phase::Similarity;
         cursor_ = 0;
         break;
       case Phase::Resample: {
         if (used++ >= budget) return false;
+        for (std::size_t i = 0; i < m; ++i) {
+          const auto g = idx(group_of_[i]);
+          const TopologyState& state = *groups_[g];
+          weight_[i] = proposal_[i] == state.nodeCount() ? group_stats_[g].new_likelihood
+                                                         : entryLikelihood(state.nodes.get(proposal_[i]), similarity_of_);
+        }
         double total = 0.0, total_sq = 0.0;
         for (double w : weight_) {
           total += w;
@@ -423,6 +427,14 @@ void TopologyParticleFilter::selectComparisons() {
   indexed_step_ = true;
   ++indexed_steps_;
   for (const int o : index_->candidates(*pending_, c.candidates)) needed_[idx(o)] = 2;
+  // The known nodes the particles propose: their likelihoods are the particles' weights, so they are
+  // compared exactly whatever the index says (the proposals do not depend on the similarities).
+  for (std::size_t i = 0; i < proposal_.size(); ++i) {
+    const TopologyState& state = *groups_[idx(group_of_[i])];
+    if (proposal_[i] >= state.nodeCount()) continue;
+    const NodeEntry& entry = state.nodes.get(proposal_[i]);
+    for (int r = 0; r < entry.representative_count; ++r) needed_[idx(entry.representatives[idx(r)])] = 2;
+  }
   std::size_t rest = 0;
   for (const std::int32_t o : needed_list_) {
     if (needed_[idx(o)] != 1) continue;

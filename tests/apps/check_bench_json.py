@@ -65,6 +65,7 @@ def check_map_size(toposlam):
     for c in out["checkpoints"]:
         assert 0 < c["median_ms"] <= c["p99_ms"] <= c["max_ms"], c
         assert c["rss_mb"] > 0 and c["stored"] > 0, c
+        assert 0 < c["comparisons_per_step"] <= c["stored"], c
     assert out["checkpoints"][-1]["index_mb"] > 0
     print("map-size JSON OK")
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <memory>
 #include <random>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -199,8 +200,8 @@ TEST_CASE("GIVEN a map no larger than exhaustive_up_to WHEN filtered THEN every 
   CHECK(stateBytes(defaults) == stateBytes(exhaustive));
 }
 
-TEST_CASE("GIVEN a map above exhaustive_up_to WHEN a place is revisited THEN only the candidates and the samples "
-          "are compared and the decisions equal the exhaustive filter's",
+TEST_CASE("GIVEN a map above exhaustive_up_to WHEN a place is revisited THEN only the candidates, the samples and "
+          "the proposed nodes are compared and the decisions equal the exhaustive filter's",
           "[topology][candidates]") {
   auto indexed_sim = TagSimilarity(tagTable);
   auto exhaustive_sim = TagSimilarity(tagTable);
@@ -228,11 +229,13 @@ TEST_CASE("GIVEN a map above exhaustive_up_to WHEN a place is revisited THEN onl
         closed_indexed += decisionOf(indexed) == k - 60 ? 1 : 0;
         closed_exhaustive += decisionOf(exhaustive) == k - 60 ? 1 : 0;
       }
-      if (indexed.indexedSteps() > 0) CHECK(indexed.lastStepComparisons() <= 5 + 30);
+      // The proposed nodes' representatives come on top: at most 2 each here (no place is seen 3 times).
+      if (indexed.indexedSteps() > 0) CHECK(indexed.lastStepComparisons() <= 5 + 30 + 2 * 200);
     }
     INFO("likelihood model " << toString(model));
     // Not every step: the filters are stochastic, a slightly different weight resamples other particles.
-    CHECK(same >= 85);  // of 90 (measured: 87 absolute, 90 relative)
+    CHECK(same >= 89);  // of 90 (measured: 89 absolute, 90 relative; 87 and 90 before the proposed nodes were
+                        // compared exactly)
     CHECK(indexed.indexedSteps() == 90 - 21);  // from the 22nd step on (21 stored > 20)
     CHECK(indexed.memoryStats().candidate_index_bytes > 0);
     // The revisits closed the loop: once under way, the robot is placed at the first pass' node.
@@ -241,7 +244,61 @@ TEST_CASE("GIVEN a map above exhaustive_up_to WHEN a place is revisited THEN onl
   }
   // Per model: exhaustive, 0 + 1 + ... + 89 comparisons; indexed, 0 + ... + 20, then at most 5 + 30 per step.
   CHECK(exhaustive_sim.calls() == 2 * 4005);
-  CHECK(indexed_sim.calls() <= 2 * (210 + 69 * 35));
+  CHECK(indexed_sim.calls() < exhaustive_sim.calls());
+}
+
+namespace {
+
+/// Records the stored fingerprints a step compared with (by address).
+class RecordingSimilarity final : public SimilarityMeasure {
+ public:
+  double similarity(const Fingerprint& reference, const Fingerprint& query) const override {
+    compared.insert(&reference);
+    return tagTable(reference.image_width - 1, query.image_width - 1);
+  }
+  mutable std::set<const Fingerprint*> compared;
+};
+
+}  // namespace
+
+TEST_CASE("GIVEN an indexed step WHEN the particles move to known nodes THEN every representative of those nodes "
+          "was compared exactly",
+          "[topology][candidates]") {
+  // The weight of a particle that proposes a known node is that node's likelihood: no background value
+  // may stand in for it. After the step, each particle's node (other than a node made by this step) is
+  // what it proposed; in this route no node holds more than 2 observations, so all of them are its
+  // representatives.
+  RecordingSimilarity sim;
+  TopologyFilterConfig config;
+  config.particles = 200;
+  config.likelihood = LikelihoodModel::Relative;
+  config.relative_offset = 3.0;
+  config.candidates.exhaustive_up_to = 20;
+  config.candidates.candidates = 2;
+  config.candidates.background_samples = 3;
+  TopologyParticleFilter filter(config, sim);
+  std::uint64_t noise = 1;
+  int checked_particles = 0;
+  for (int p : loopRoute()) {
+    sim.compared.clear();
+    filter.step(placeFingerprint(p, 12, noise++));
+    if (filter.indexedSteps() == 0) continue;
+    const int k = filter.observationCount() - 1;
+    for (int i = 0; i < config.particles; ++i) {
+      const std::vector<int> assignment = filter.particleAssignment(i);
+      const int node = assignment.back();
+      std::vector<int> members;
+      for (int o = 0; o < k; ++o)
+        if (assignment[static_cast<std::size_t>(o)] == node) members.push_back(o);
+      if (members.empty()) continue;  // a new node
+      ++checked_particles;
+      for (const int o : members) {
+        INFO("step " << k << " particle " << i << " node of observation " << members.front() << " member " << o);
+        CHECK(sim.compared.count(filter.storedRepresentative(o).get()) == 1);
+      }
+    }
+  }
+  CHECK(checked_particles > 5000);  // of 69 x 200 (measured 6107): most particles move to a known node
 }
 
 TEST_CASE("GIVEN a fork of the filter WHEN both take the same step THEN their states are identical, and the "

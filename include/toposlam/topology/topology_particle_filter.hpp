@@ -2,11 +2,12 @@
 //
 // Every new place representative is one time step k. A particle is one hypothesis of the whole node
 // assignment sequence L_1..L_k (a "topology": which observations show the same node). Per step:
-//   1. the similarity of the new representative with every representative still stored by some particle
-//      is computed ONCE (SimilarityMeasure::similarity(reference = stored, query = new));
-//   2. each particle proposes its next node from the transition model: eq. 5.8 from a node without
+//   1. each particle proposes its next node from the transition model: eq. 5.8 from a node without
 //      adjacency information (never left yet), else the gamma(k = 10, theta = 0.25) model over "stay",
 //      1st, 2nd, ... successor plus a fixed probability of a new node;
+//   2. the similarity of the new representative with every representative still stored by some particle
+//      is computed ONCE (SimilarityMeasure::similarity(reference = stored, query = new); above
+//      CandidateSelectionConfig::exhaustive_up_to only with some of them, see there);
 //   3. its weight is the appearance likelihood: for a known node m the max similarity over the
 //      representatives this particle gave m; for a new node eta * (1 - max_m), eta the normalised entropy
 //      of the normalised known-node likelihoods (eq. 5.6/5.7; eta = 1 with a single known node);
@@ -76,14 +77,16 @@ double relativeLikelihood(double similarity, double others_sum, double others_su
 /// How step 1 compares the new representative once many are stored (issue 18, docs/topology.md "Large
 /// maps"). Up to `exhaustive_up_to` stored representatives it is compared with every one (the thesis).
 /// Above, a PlaceCandidateIndex over the stored descriptors picks the `candidates` most likely ones; those,
-/// every stored representative the index cannot hold (no binary descriptors), and `background_samples`
-/// others spread evenly over the rest are compared exactly; every other stored representative is given
+/// every stored representative the index cannot hold (no binary descriptors), every representative of a
+/// known node some particle proposes this step (its likelihood is that particle's weight; the proposals
+/// are drawn before the similarities, which they do not depend on), and `background_samples` others
+/// spread evenly over the rest are compared exactly; every other stored representative is given
 /// the mean similarity of those samples (the background), and the relative likelihood's spread includes
 /// the samples' variance for them. Not saved with the map: it is how this process runs, not what the map is.
 struct CandidateSelectionConfig {
   int exhaustive_up_to = 1000;  ///< stored representatives compared exhaustively; allowed [0, 1e9]
-  int candidates = 200;         ///< compared exactly from the index's top; allowed [1, 100000]
-  int background_samples = 300; ///< others compared exactly for the background; allowed [0, 100000]
+  int candidates = 100;         ///< compared exactly from the index's top; allowed [1, 100000]
+  int background_samples = 100; ///< others compared exactly for the background; allowed [0, 100000]
   PlaceCandidateIndexConfig index;
   std::string validate() const;
 };
@@ -250,7 +253,7 @@ class TopologyParticleFilter {
                                                            const SimilarityMeasure& similarity);
 
  private:
-  enum class Phase : std::uint8_t { Idle, Collect, Similarity, Aggregate, Propose, Resample, Update };
+  enum class Phase : std::uint8_t { Idle, Collect, Propose, Similarity, Aggregate, Resample, Update };
   using StatePtr = std::shared_ptr<const topology_detail::TopologyState>;
 
   double uniform01();

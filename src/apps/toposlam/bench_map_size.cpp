@@ -13,7 +13,8 @@
 // fork takes the same step exhaustively: the decision (the founding observation of the most probable
 // current node over the particles) is compared with the indexed step's, over all compared steps and over
 // those where the exhaustive filter has decided (its most probable node has p >= 0.5). Timings are the indexed filter's steps only; RSS is the
-// process's (VmRSS) at each checkpoint. Prints numbers (and an SVG with --svg), fails nothing.
+// process's (VmRSS) at each checkpoint; "compared" is the mean number of exact similarity evaluations per
+// step. Prints numbers (and an SVG with --svg), fails nothing.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -116,6 +117,7 @@ struct Checkpoint {
   std::size_t stored = 0;
   TimingSummary step;
   double rss_mb = 0, index_mb = 0;
+  double comparisons = 0;  ///< exact similarity evaluations per step, mean over the window
   int compared = 0, agreed = 0;
   int confident = 0, confident_agreed = 0;  ///< steps where the exhaustive decision has p >= 0.5
 };
@@ -161,6 +163,7 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   std::vector<Checkpoint> checkpoints;
   // The plot: per 1 % of the run, the median and p99 ms of its steps and the resident MB at its end.
   const int plot_every = std::max(1, o.places / 100);
+  double window_comparisons = 0;
   std::vector<double> window_ms, plot_window_ms, plot_x, plot_median, plot_p99, plot_rss;
   int compared = 0, agreed = 0, window_compared = 0, window_agreed = 0;
   int confident = 0, confident_agreed = 0, window_confident = 0, window_confident_agreed = 0;
@@ -169,10 +172,10 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   if (!o.json)
     std::printf("map-size: %d steps, %d particles, %zu donor frames of %s; exhaustive up to %d stored, then %d "
                 "candidates + %d background samples; decisions compared every %d steps\n%8s %8s %10s %10s %10s "
-                "%8s %9s %14s %14s\n",
+                "%8s %9s %9s %14s %14s\n",
                 o.places, o.particles, donors.size(), o.samples.c_str(), o.candidates.exhaustive_up_to,
                 o.candidates.candidates, o.candidates.background_samples, o.compare_every, "steps", "stored",
-                "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "same decision", "when p >= 0.5");
+                "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "compared", "same decision", "when p >= 0.5");
   for (int k = 0; k < o.places; ++k) {
     const auto observation = observationOf(prototype(route[static_cast<std::size_t>(k)]), rng);
     std::unique_ptr<TopologyParticleFilter> shadow;
@@ -184,6 +187,7 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
     filter.step(observation);
     const double ms = watch.elapsedMs();
     window_ms.push_back(ms);
+    window_comparisons += static_cast<double>(filter.lastStepComparisons());
     plot_window_ms.push_back(ms);
     if ((k + 1) % plot_every == 0) {
       const TimingSummary s = summarize(plot_window_ms);
@@ -231,6 +235,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       c.steps = k + 1;
       c.stored = filter.memoryStats().stored_fingerprints;
       c.step = summarize(window_ms);
+      c.comparisons = window_comparisons / static_cast<double>(window_ms.size());
+      window_comparisons = 0;
       c.rss_mb = static_cast<double>(residentBytes()) / (1024.0 * 1024.0);
       c.index_mb = static_cast<double>(filter.memoryStats().candidate_index_bytes) / (1024.0 * 1024.0);
       c.compared = window_compared;
@@ -241,8 +247,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       window_ms.clear();
       window_compared = window_agreed = window_confident = window_confident_agreed = 0;
       if (!o.json) {
-        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %8d of %3d %8d of %3d\n", c.steps, c.stored,
-                    c.step.median_ms, c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.agreed, c.compared,
+        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %9.0f %8d of %3d %8d of %3d\n", c.steps, c.stored,
+                    c.step.median_ms, c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.comparisons, c.agreed, c.compared,
                     c.confident_agreed, c.confident);
         std::fflush(stdout);
       }
@@ -265,7 +271,7 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       json.beginObject();
       json.field("steps", c.steps).field("stored", c.stored).field("median_ms", c.step.median_ms);
       json.field("p99_ms", c.step.p99_ms).field("max_ms", c.step.max_ms).field("rss_mb", c.rss_mb);
-      json.field("index_mb", c.index_mb).field("compared", c.compared).field("same", c.agreed);
+      json.field("index_mb", c.index_mb).field("comparisons_per_step", c.comparisons).field("compared", c.compared).field("same", c.agreed);
       json.field("confident", c.confident).field("confident_same", c.confident_agreed);
       json.endObject();
     }
