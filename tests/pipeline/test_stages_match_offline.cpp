@@ -10,7 +10,7 @@
 #include "../segmentation/fake_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/clock.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 
 using namespace toposlam;
 

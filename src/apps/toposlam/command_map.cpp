@@ -37,7 +37,7 @@
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/programs.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "fake_similarity.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "segmentation/fake_similarity.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 
 using namespace toposlam;
 using toposlam::test::fakeFingerprint;

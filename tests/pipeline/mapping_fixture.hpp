@@ -17,7 +17,7 @@
 #include "toposlam/eval/metrics.hpp"
 #include "toposlam/eval/run_files.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace toposlam::testing {

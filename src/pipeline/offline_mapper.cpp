@@ -1,5 +1,5 @@
 // OfflineMapper: fingerprint -> segment -> topology filter step, over consecutive traversals.
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 
 #include <stdexcept>
 #include <utility>
