@@ -1,118 +1,78 @@
-// OfflineMapper: fingerprint -> segment -> topology filter step, over consecutive traversals.
+// OfflineMapper: the stage adapters driven in order on one thread, and the run's frame and place rows.
 #include "toposlam/pipeline/offline_mapper.hpp"
 
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
 namespace toposlam {
 
-namespace {
-
-SegmentedPlace shifted(SegmentedPlace p, std::int64_t frame_offset, std::int64_t index_offset) {
-  p.first_frame += frame_offset;
-  p.last_frame += frame_offset;
-  p.representative_frame += frame_offset;
-  if (p.valley_frame >= 0) p.valley_frame += frame_offset;
-  p.index += index_offset;
-  return p;
-}
-
-}  // namespace
-
-void appendSegmentationRun(SegmentationRun& all, const SegmentationRun& part) {
-  const auto frame_offset = static_cast<std::int64_t>(all.frames.size());
-  const auto kept_offset = static_cast<std::int64_t>(all.places.size());
-  const auto dropped_offset = static_cast<std::int64_t>(all.dropped_places.size());
-  for (SegmentationFrameRecord f : part.frames) {
-    f.frame += frame_offset;
-    if (f.place >= 0) f.place += kept_offset;
-    all.frames.push_back(std::move(f));
-  }
-  for (const SegmentedPlace& p : part.places) {
-    all.places.push_back(shifted(p, frame_offset, kept_offset));
-    all.places.back().representative.reset();
-  }
-  for (const SegmentedPlace& p : part.dropped_places) {
-    all.dropped_places.push_back(shifted(p, frame_offset, dropped_offset));
-    all.dropped_places.back().representative.reset();
-  }
-}
-
-OfflineMapper::OfflineMapper(const VpackExtractor& extractor, const SimilarityMeasure& similarity,
-                             const FiedlerSegmenterConfig& config, TopologyParticleFilter& filter)
-    : extractor_(extractor),
-      similarity_(similarity),
-      config_(config),
-      filter_(filter),
-      first_observation_(filter.observationCount()) {
-  if (const std::string problem = config_.validate(); !problem.empty()) {
-    throw std::invalid_argument("segmentation config: " + problem);
-  }
-}
-
-void OfflineMapper::useSequenceEvidence(const SequenceEvidenceConfig& config) {
-  if (!finished_.frames.empty() || current_) throw std::logic_error("OfflineMapper: sequence evidence after the first frame");
-  evidence_ = config.weight > 0.0 ? std::make_unique<PlaceSequenceEvidence>(config, similarity_) : nullptr;
-}
+OfflineMapper::OfflineMapper(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
+                             ParticleFilterTopologyStage* topology)
+    : fingerprint_(fingerprint),
+      segmentation_(segmentation),
+      topology_(topology),
+      first_observation_(topology != nullptr ? topology->observations() : 0) {}
 
 void OfflineMapper::beginTraversal() {
-  if (current_) finish();
-  if (evidence_) evidence_->beginTraversal();
-  current_ = std::make_unique<OfflineSegmentation>(extractor_, similarity_, config_);
+  if (open_) finish();
+  segmentation_.beginTraversal();
   ++traversal_count_;
+  open_ = true;
 }
 
-std::shared_ptr<const Fingerprint> OfflineMapper::fingerprint(const cv::Mat& image) const {
-  return std::make_shared<const Fingerprint>(extractor_.extract(image));
+std::shared_ptr<const Fingerprint> OfflineMapper::fingerprint(const cv::Mat& image, const cv::Mat& grey) {
+  return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey));
 }
 
-SegmentedPlace OfflineMapper::toRunNumbering(SegmentedPlace place) const {
-  const auto frame_offset = static_cast<std::int64_t>(finished_.frames.size());
-  const auto index_offset =
-      static_cast<std::int64_t>(place.dropped ? finished_.dropped_places.size() : finished_.places.size());
-  return shifted(std::move(place), frame_offset, index_offset);
-}
-
-SegmenterStep OfflineMapper::segment(double time_s, const std::string& name,
-                                     std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
-  if (!current_) beginTraversal();
-  const std::shared_ptr<const Fingerprint> for_evidence = evidence_ ? fingerprint : nullptr;
-  SegmenterStep step = current_->segment(time_s, name, std::move(fingerprint), motion);
-  step.frame += static_cast<std::int64_t>(finished_.frames.size());
-  if (evidence_) evidence_->addFrame(step.frame, time_s, for_evidence);
-  if (step.closed_place) step.closed_place = toRunNumbering(std::move(*step.closed_place));
+SegmenterStep OfflineMapper::segment(double source_time_s, const std::string& name,
+                                     std::shared_ptr<const Fingerprint> fingerprint) {
+  if (!open_) beginTraversal();
+  SegmentationFrameRecord row;
+  row.frame = static_cast<std::int64_t>(run_.frames.size());
+  row.name = name;
+  row.keypoints = fingerprint ? fingerprint->keypointCount() : 0;
+  // The offline run has no pipeline clock: motion is looked up at the frame's own time, the motion file's.
+  SegmentationStep stage_step = segmentation_.process(row.frame, source_time_s, source_time_s, std::move(fingerprint), cv::Mat());
+  row.time_s = segmentation_.lastFrameTimeS();
+  SegmenterStep step;
+  step.frame = row.frame;
+  if (!std::isnan(stage_step.lambda2)) step.lambda2 = stage_step.lambda2;
+  row.lambda2 = step.lambda2;
+  run_.frames.push_back(std::move(row));
+  pending_ = std::move(stage_step.closed);
+  if (segmentation_.lastClosedPlace()) {
+    step.closed_place = *segmentation_.lastClosedPlace();
+    record(*step.closed_place);
+  }
   return step;
 }
 
 std::optional<MappedPlace> OfflineMapper::mapPlace(const SegmentedPlace& place) {
-  if (place.dropped) return std::nullopt;
-  if (!place.representative) throw std::invalid_argument("OfflineMapper::mapPlace: place without a representative");
-  if (evidence_) {
-    // Evidence by kept place of this run; the filter numbers observations from the map's first one.
-    const std::vector<double> by_place = evidence_->closePlace(place.first_frame, place.last_frame);
-    std::vector<double> by_observation(static_cast<std::size_t>(first_observation_), 0.0);
-    by_observation.insert(by_observation.end(), by_place.begin(), by_place.end());
-    filter_.step(place.representative, by_observation);
-  } else {
-    filter_.step(place.representative);
-  }
-  MappedPlace mapped{place, filter_.estimate(3)};
-  mapped.place.representative.reset();  // the filter keeps what it needs
+  if (place.dropped || topology_ == nullptr) return std::nullopt;
+  if (!pending_ || pending_->place != place.index)
+    throw std::logic_error("OfflineMapper::mapPlace: not the kept place the segmentation closed last");
+  topology_->enqueuePlace(*pending_);
+  pending_.reset();
+  while (!topology_->idle()) topology_->advance(std::numeric_limits<double>::infinity());
+  MappedPlace mapped{place, topology_->filter().estimate(3)};
+  mapped.place.representative.reset();
   steps_.push_back(mapped);
   return mapped;
 }
 
 std::optional<SegmentedPlace> OfflineMapper::finishTraversal() {
-  if (!current_) return std::nullopt;
-  std::optional<SegmentedPlace> last = current_->finish();
-  if (last) last = toRunNumbering(std::move(*last));
-  appendSegmentationRun(finished_, current_->run());
-  current_.reset();
+  if (!open_) return std::nullopt;
+  open_ = false;
+  pending_ = segmentation_.finish();
+  const std::optional<SegmentedPlace>& last = segmentation_.lastClosedPlace();
+  if (last) record(*last);
   return last;
 }
 
-void OfflineMapper::process(const cv::Mat& image, double time_s, const std::string& name) {
-  const SegmenterStep step = segment(time_s, name, fingerprint(image));
+void OfflineMapper::process(const cv::Mat& image, double source_time_s, const std::string& name) {
+  const SegmenterStep step = segment(source_time_s, name, fingerprint(image));
   if (step.closed_place) mapPlace(*step.closed_place);
 }
 
@@ -120,18 +80,26 @@ void OfflineMapper::finish() {
   if (std::optional<SegmentedPlace> last = finishTraversal()) mapPlace(*last);
 }
 
-SegmentationRun OfflineMapper::run() const {
-  SegmentationRun all = finished_;
-  if (current_) appendSegmentationRun(all, current_->run());
-  return all;
+void OfflineMapper::record(const SegmentedPlace& place) {
+  const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, place.first_frame));
+  const auto end = std::min(run_.frames.size(), static_cast<std::size_t>(place.last_frame + 1));
+  for (std::size_t f = first; f < end; ++f) {
+    run_.frames[f].place = place.dropped ? -1 : place.index;
+    run_.frames[f].in_dropped_place = place.dropped;
+  }
+  (place.dropped ? run_.dropped_places : run_.places).push_back(place);
 }
 
 std::vector<std::int64_t> OfflineMapper::placeNodes() const {
-  const TopologyEstimate estimate = filter_.estimate(0);
-  const std::vector<int>& assignment = estimate.best.assignment;
   std::vector<std::int64_t> nodes;
-  for (std::size_t k = static_cast<std::size_t>(first_observation_); k < assignment.size(); ++k) {
-    nodes.push_back(assignment[k]);
+  if (topology_ == nullptr) return nodes;
+  // The topology stage's snapshot (the one toposlamd publishes) lists each node's places by observation.
+  const TopologySnapshot best = topology_->topology();
+  nodes.assign(static_cast<std::size_t>(topology_->observations() - first_observation_), -1);
+  for (const TopologyNode& node : best.nodes) {
+    for (const int observation : node.places) {
+      if (observation >= first_observation_) nodes[static_cast<std::size_t>(observation - first_observation_)] = node.id;
+    }
   }
   return nodes;
 }
