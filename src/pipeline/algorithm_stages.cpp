@@ -18,7 +18,8 @@ FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig&
                                                    const SimilarityMeasure& similarity,
                                                    std::size_t max_thumbnails, const MotionGateConfig& motion,
                                                    const SequenceEvidenceConfig& evidence)
-    : segmenter_(config, similarity),
+    : similarity_(similarity),
+      segmenter_(std::in_place, config, similarity),
       evidence_(evidence.weight > 0.0 ? std::make_unique<PlaceSequenceEvidence>(evidence, similarity) : nullptr),
       max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)),
       gate_(motion) {
@@ -53,7 +54,7 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   if (last_motion_.known != was_known) {
     if (last_motion_.known) {
       spdlog::info("segmentation: robot motion known; standing frames skipped{}",
-                   segmenter_.config().window_m > 0.0 ? ", window in metres" : "");
+                   segmenter_->config().window_m > 0.0 ? ", window in metres" : "");
     } else if (gate_.samples() > 0) {
       spdlog::warn("segmentation: robot motion lost (no sample for {} s); segmenting by time",
                    gate_.config().timeout_s);
@@ -75,34 +76,51 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   // does not increase (a source without timestamps) advances by a second, as before.
   const std::int64_t steps_back = timeline_.stepsBack();
   const double time_s = timeline_.place(source_time_s);
+  last_time_s_ = time_s;
   if (timeline_.stepsBack() > steps_back && (steps_back < 10 || steps_back % 1000 == 0))
     spdlog::warn("segmentation: frame {}'s source time went back {:.3f} s (to {:.3f} s); the window's clock carries on "
                  "from the frame before ({} such steps so far)",
                  sequence, timeline_.lastStepBackS(), source_time_s, steps_back + 1);
   if (evidence_) evidence_->addFrame(sequence, time_s, fingerprint);
-  SegmenterStep step = segmenter_.addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
+  SegmenterStep step = segmenter_->addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   if (motion_counters_ != nullptr) {
     const MotionUse use = last_motion_.known ? MotionUse::Used : gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
     motion_counters_->use.store(static_cast<int>(use));
-    motion_counters_->standing_frames.store(segmenter_.skippedFrames());
+    motion_counters_->standing_frames.store(skippedFrames());
   }
   SegmentationStep out;
+  last_closed_.reset();
   if (step.lambda2) out.lambda2 = *step.lambda2;
   if (step.closed_place) out.closed = toClosedPlace(*step.closed_place);
   return out;
 }
 
 std::optional<ClosedPlace> FiedlerSegmentationStage::finish() {
-  const std::optional<SegmentedPlace> last = segmenter_.flush();
+  last_closed_.reset();
+  const std::optional<SegmentedPlace> last = segmenter_->flush();
   if (!last) return std::nullopt;
   return toClosedPlace(*last);
 }
 
-std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const SegmentedPlace& p) {
+void FiedlerSegmentationStage::beginTraversal() {
+  kept_before_ = kept_places_;
+  dropped_before_ = dropped_places_;
+  skipped_before_ += segmenter_->skippedFrames();
+  const FiedlerSegmenterConfig config = segmenter_->config();  // a copy: emplace() destroys the old one first
+  segmenter_.emplace(config, similarity_);
+  timeline_ = FrameTimeline{};
+  if (evidence_) evidence_->beginTraversal();
+  thumbnails_.clear();
+}
+
+std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const SegmentedPlace& closed) {
+  SegmentedPlace p = closed;
+  p.index += p.dropped ? dropped_before_ : kept_before_;  // numbered over the run, not the traversal
   std::optional<ClosedPlace> out;
   if (p.dropped) {
     ++dropped_places_;
   } else {
+    ++kept_places_;
     ClosedPlace place;
     place.place = static_cast<int>(p.index);
     place.first_frame = p.first_frame;
@@ -118,6 +136,8 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
   }
   // Frames up to the closed place's end are no longer needed.
   std::erase_if(thumbnails_, [&](const auto& entry) { return entry.first <= p.last_frame; });
+  p.representative.reset();  // the topology stage holds it as long as it needs it
+  last_closed_ = std::move(p);
   return out;
 }
 

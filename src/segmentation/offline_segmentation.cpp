@@ -1,4 +1,4 @@
-// OfflineSegmentation: fingerprint -> segment for file-based runs, and the run-folder writers.
+// The run-folder writers of an offline run's segmentation rows.
 #include "toposlam/segmentation/offline_segmentation.hpp"
 
 #include <cmath>
@@ -28,48 +28,6 @@ std::int64_t nodeOf(const std::vector<std::int64_t>& place_nodes, std::int64_t p
 }
 
 }  // namespace
-
-OfflineSegmentation::OfflineSegmentation(const VpackExtractor& extractor, const SimilarityMeasure& similarity,
-                                         const FiedlerSegmenterConfig& config)
-    : extractor_(extractor), segmenter_(config, similarity) {}
-
-std::shared_ptr<const Fingerprint> OfflineSegmentation::fingerprint(const cv::Mat& image) const {
-  return std::make_shared<const Fingerprint>(extractor_.extract(image));
-}
-
-SegmenterStep OfflineSegmentation::segment(double time_s, const std::string& name,
-                                           std::shared_ptr<const Fingerprint> fingerprint, const MotionState& motion) {
-  SegmentationFrameRecord row;
-  row.frame = static_cast<std::int64_t>(run_.frames.size());
-  row.time_s = time_s;
-  row.name = name;
-  row.keypoints = fingerprint ? fingerprint->keypointCount() : 0;
-  SegmenterStep step = segmenter_.addFrame(row.frame, time_s, std::move(fingerprint), motion);
-  row.lambda2 = step.lambda2;
-  run_.frames.push_back(std::move(row));
-  if (step.closed_place) record(*step.closed_place);
-  return step;
-}
-
-SegmenterStep OfflineSegmentation::process(const cv::Mat& image, double time_s, const std::string& name) {
-  return segment(time_s, name, fingerprint(image));
-}
-
-std::optional<SegmentedPlace> OfflineSegmentation::finish() {
-  std::optional<SegmentedPlace> last = segmenter_.flush();
-  if (last) record(*last);
-  return last;
-}
-
-void OfflineSegmentation::record(const SegmentedPlace& place) {
-  const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, place.first_frame));
-  const auto end = std::min(run_.frames.size(), static_cast<std::size_t>(place.last_frame + 1));
-  for (std::size_t f = first; f < end; ++f) {
-    run_.frames[f].place = place.dropped ? -1 : place.index;
-    run_.frames[f].in_dropped_place = place.dropped;
-  }
-  (place.dropped ? run_.dropped_places : run_.places).push_back(place);
-}
 
 void writeFramesCsv(std::ostream& out, const SegmentationRun& run,
                     const std::vector<std::int64_t>& place_nodes, const FrameLoopColumns* loop) {

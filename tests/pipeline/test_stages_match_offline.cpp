@@ -10,7 +10,7 @@
 #include "../segmentation/fake_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/clock.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 
 using namespace toposlam;
 
@@ -61,18 +61,18 @@ TEST_CASE("GIVEN sequence evidence on WHEN the daemon's stages and the offline m
   }
   if (auto last = segmenter.finish()) mapOnline(*last);
 
-  // The offline mapper.
-  const VpackExtractor extractor{VpackConfig{}};
-  TopologyParticleFilter offline_filter(topology(), similarity);
-  OfflineMapper mapper(extractor, similarity, segmentation(), offline_filter);
-  mapper.useSequenceEvidence(evidenceOn());
+  // The offline mapper, on stages of its own.
+  VpackFingerprintStage fingerprints(VpackConfig{}, nullptr);  // unused: fingerprints are made up
+  FiedlerSegmentationStage offline_segmenter(segmentation(), similarity, 1, {}, evidenceOn());
+  ParticleFilterTopologyStage offline_filter(topology(), similarity, clock, {64, 3});
+  OfflineMapper mapper(fingerprints, offline_segmenter, &offline_filter);
   for (int f = 0; f < 2 * kLap; ++f) {
     const SegmenterStep step = mapper.segment(timeOf(f), "", test::fakeFingerprint(f));
     if (step.closed_place) mapper.mapPlace(*step.closed_place);
   }
   if (auto last = mapper.finishTraversal()) mapper.mapPlace(*last);
 
-  const SegmentationRun run = mapper.run();
+  const SegmentationRun& run = mapper.run();
   REQUIRE(run.places.size() == stage_places.size());
   REQUIRE(stage_places.size() == 6u);  // three blocks a lap
   for (std::size_t p = 0; p < stage_places.size(); ++p) {

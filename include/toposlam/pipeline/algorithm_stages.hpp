@@ -79,6 +79,10 @@ struct MotionSample {
 /// Motion (docs/segmentation.md, "Motion-aware segmentation"): samples given to addMotion() (any thread)
 /// are applied to a MotionGate, in order, before the next frame; each frame then asks the gate at its
 /// captured_at_s. Without samples the segmentation is exactly the one without motion.
+///
+/// Traversals (the offline commands' sources, OfflineMapper): beginTraversal() starts a fresh window and
+/// clock; places go on being numbered over the whole run, and the sequence evidence carries on. The
+/// daemon has one traversal.
 class FiedlerSegmentationStage final : public SegmentationStage {
  public:
   /// `evidence` with weight > 0: every closed place carries the sequence evidence of its frames
@@ -90,6 +94,18 @@ class FiedlerSegmentationStage final : public SegmentationStage {
                            const cv::Mat& thumbnail) override;
   std::optional<ClosedPlace> finish() override;
   std::int64_t droppedPlaces() const { return dropped_places_; }
+  std::int64_t keptPlaces() const { return kept_places_; }
+
+  /// The next frame starts a traversal of its own (a new source): a fresh segmentation window (the open
+  /// place must have been closed by finish()) and a fresh clock (sourceTimeline()); place numbers and the
+  /// sequence evidence carry on. Frame numbers (process()'s `sequence`) must still increase.
+  void beginTraversal();
+  /// The place the last process() or finish() closed, kept or dropped, numbered over the run (kept and
+  /// dropped places each from 0, in closing order); its representative is not kept here. Empty when that
+  /// call closed none. For the run folder's places.csv and dropped_places.csv (OfflineMapper).
+  const std::optional<SegmentedPlace>& lastClosedPlace() const { return last_closed_; }
+  /// The segmenter's settings.
+  const FiedlerSegmenterConfig& segmenterConfig() const { return segmenter_->config(); }
 
   /// Any thread. Queues a sample for the segmentation thread; at most kMaxPendingMotion wait (beyond,
   /// the oldest is dropped and counted in droppedMotionSamples()).
@@ -98,12 +114,17 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   /// Segmentation thread (or after it ended): the gate's state at the last frame, frames skipped as
   /// standing, samples the gate refused (time going back, not finite) or that overflowed the queue.
   MotionState lastMotion() const { return last_motion_; }
-  std::int64_t skippedFrames() const { return segmenter_.skippedFrames(); }
+  std::int64_t skippedFrames() const { return skipped_before_ + segmenter_->skippedFrames(); }
+  std::int64_t motionSamples() const { return gate_.samples(); }  ///< samples the gate took
   std::int64_t refusedMotionSamples() const { return gate_.rejectedSamples(); }
   std::int64_t droppedMotionSamples() const;
   /// Segmentation thread (or after it ended): frames whose source time went back, which the window's
   /// clock carried on from the frame before (FrameTimeline).
   std::int64_t sourceTimeStepsBack() const { return timeline_.stepsBack(); }
+  /// The current traversal's clock (its steps back, for a summary).
+  const FrameTimeline& sourceTimeline() const { return timeline_; }
+  /// The last frame's time on the window's clock (its source time with the steps back cut out), seconds.
+  double lastFrameTimeS() const { return last_time_s_; }
   /// From now on, every frame writes whether motion is used and the standing frames so far into
   /// `counters` (may be null: nowhere), which must outlive the stage; any thread may read them.
   void reportMotionTo(MotionStatusCounters* counters) { motion_counters_ = counters; }
@@ -113,17 +134,24 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   /// thumbnails of its frames.
   std::optional<ClosedPlace> toClosedPlace(const SegmentedPlace& place);
 
-  FiedlerSegmenter segmenter_;
+  const SimilarityMeasure& similarity_;
+  std::optional<FiedlerSegmenter> segmenter_;        ///< always set; a fresh one per traversal
   std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: no sequence evidence
   std::size_t max_thumbnails_;
   /// (frame, thumbnail) of the open place's frames, in arrival order; capacity max_thumbnails_ reserved
   /// once, so a frame costs no node allocation.
   std::vector<std::pair<std::int64_t, cv::Mat>> thumbnails_;
   std::int64_t dropped_places_ = 0;
+  std::int64_t kept_places_ = 0;
+  std::int64_t kept_before_ = 0;     ///< kept places of earlier traversals (the segmenter numbers its own)
+  std::int64_t dropped_before_ = 0;  ///< dropped places of earlier traversals
+  std::int64_t skipped_before_ = 0;  ///< standing frames of earlier traversals
+  std::optional<SegmentedPlace> last_closed_;
 
   MotionGate gate_;
   MotionState last_motion_;
   FrameTimeline timeline_;  ///< the window's clock: source times with their steps back cut out
+  double last_time_s_ = 0.0;
   mutable std::mutex motion_mutex_;
   std::deque<MotionSample> pending_motion_;  ///< guarded by motion_mutex_
   std::deque<MotionSample> applying_;        ///< segmentation thread: swapped out of pending_motion_
@@ -165,6 +193,9 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   std::unique_ptr<const MapSnapshot> snapshotMap() const override;
 
   int observations() const { return filter_->observationCount(); }
+  /// The filter itself, read-only (its full estimate, its config, MapStore::save); valid until the next
+  /// loadMap() or adoptMap().
+  const TopologyParticleFilter& filter() const { return *filter_; }
 
  private:
   void refresh();  ///< recomputes estimate_ and topology_ after a finished step (or a load)

@@ -34,10 +34,12 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
+#include "toposlam/pipeline/algorithm_stages.hpp"
+#include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/programs.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"
@@ -151,7 +153,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   if (o.max_keypoints >= 0) vpack.keypoints.setMaxKeypoints(o.max_keypoints);
-  const VpackExtractor extractor(vpack);
+  VpackFingerprintStage fingerprint_stage(vpack, nullptr);
   // The thesis has no frame-level detector of its own: its preset reads frame closures off the topology.
   const bool by_sequence =
       o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
@@ -165,7 +167,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   if (o.histogram_gate >= 0) similarity_config.histogram_gate = o.histogram_gate == 1;
   const NgramSimilarity similarity(similarity_config);
 
-  std::unique_ptr<TopologyParticleFilter> filter;
+  // The filter steps run to their end before the next frame, so the budget's clock is never read for a
+  // decision (ParticleFilterTopologyStage::advance with an infinite budget).
+  const ManualClock clock;
+  TopologyStageConfig topology_stage;
+  std::unique_ptr<ParticleFilterTopologyStage> topology;
   std::vector<ObservationOrigin> origins;
   int run_number = 0;
   if (!o.resume.empty()) {
@@ -189,11 +195,13 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       if (const std::string refusal = MapStore::checkSettings(loaded.settings, current, o.resume); !refusal.empty())
         throw ConfigError("map: " + refusal + " (" + hint + ")");
     }
-    filter = std::move(loaded.filter);
-    filter->setCandidateSelection(o.candidates);  // how this run compares, not saved with the map
-    origins = decodeOrigins(loaded.application_data, filter->observationCount());
+    TopologyFilterConfig config = loaded.filter->config();
+    config.candidates = o.candidates;  // how this run compares, not saved with the map (adoptMap applies it)
+    topology = std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, topology_stage);
+    origins = decodeOrigins(loaded.application_data, loaded.filter->observationCount());
+    topology->adoptMap(std::move(loaded));
     for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
-    std::cerr << "map: resumed " << o.resume << " (" << filter->observationCount() << " places)\n";
+    std::cerr << "map: resumed " << o.resume << " (" << topology->observations() << " places)\n";
   } else {
     TopologyFilterConfig config = preset.topology;
     config.particles = o.particles;
@@ -207,11 +215,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     config.candidates = o.candidates;
     if (const std::string problem = config.validate(); !problem.empty())
       throw std::invalid_argument("map: " + problem);
-    filter = std::make_unique<TopologyParticleFilter>(config, similarity);
+    topology = std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, topology_stage);
   }
-  const int first_observation = filter->observationCount();
+  const TopologyParticleFilter& filter = topology->filter();
+  const int first_observation = filter.observationCount();
 
-  OfflineMapper mapper(extractor, similarity, segmenter_config, *filter);
   SequenceEvidenceConfig evidence;
   evidence.loop = sequence_loops;
   evidence.weight = o.sequence_evidence;
@@ -219,7 +227,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   evidence.min_relative = o.sequence_evidence_min_relative;
   evidence.min_share = o.sequence_evidence_min_share;
   if (const std::string problem = evidence.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
-  mapper.useSequenceEvidence(evidence);
+  // Thumbnails are the daemon's (place events); the offline run keeps none.
+  FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
+  OfflineMapper mapper(fingerprint_stage, segmentation_stage, topology.get());
   std::vector<FrameTiming> timing;
   std::int64_t refused = 0;
   // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
@@ -244,9 +254,9 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::unique_ptr<FrameSource> source = openSource(uri);
     std::cerr << "map: " << source->describe() << "\n";
     mapper.beginTraversal();  // fresh segmentation window per traversal
-    // Each traversal's own clock, with any step back inside it cut out (docs/reliability.md, "Clock
-    // jumps"); the next source starts its own, so where it goes back a new traversal begins (frames.csv).
-    FrameTimeline timeline;
+    // Each traversal has its own clock, with any step back inside it cut out (the segmentation stage's;
+    // docs/reliability.md, "Clock jumps"); the next source starts its own, so where it goes back a new
+    // traversal begins (frames.csv).
     Progress source_progress("map", "frames", source->frameCountHint());
     progress = &source_progress;
     std::int64_t read = 0;
@@ -257,7 +267,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       auto start = std::chrono::steady_clock::now();
       std::shared_ptr<const Fingerprint> fingerprint;
       try {
-        fingerprint = mapper.fingerprint(frame->image);
+        fingerprint = mapper.fingerprint(frame->image, frame->grey);
       } catch (const std::invalid_argument& e) {
         // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
         if (refused++ == 0) std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
@@ -269,8 +279,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       // With several sources, names carry their source's folder ("ref/0001.jpg", "query/0001.jpg") so
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
-      const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
-      const SegmenterStep step = mapper.segment(timeline.place(frame->timestamp_s), name, std::move(fingerprint), moving);
+      if (motion) motion->feedUpTo(frame->timestamp_s, segmentation_stage);
+      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint));
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
@@ -281,10 +291,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     progress = nullptr;
     if (source->skippedFrames() > 0)
       std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
-    if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "map") << "\n";
+    if (const FrameTimeline& timeline = segmentation_stage.sourceTimeline(); timeline.stepsBack() > 0)
+      std::cerr << timelineSummary(timeline, "map") << "\n";
   }
-  if (motion) std::cerr << motionSummary(*motion, o.motion, "map") << "\n";
-  const SegmentationRun all = mapper.run();
+  if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
+  const SegmentationRun& all = mapper.run();
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
                              " refused)");
@@ -292,15 +303,14 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
   MapSettings made_with = fingerprintMapSettings(vpack);
   made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
-  MapStore::save(map_path, *filter, encodeOrigins(origins), made_with);
+  MapStore::save(map_path, filter, encodeOrigins(origins), made_with);
 
   // The most probable topology decides every place's node.
-  const TopologyEstimate final_estimate = filter->estimate(3);
-  const std::vector<int>& assignment = final_estimate.best.assignment;
+  const TopologyEstimate final_estimate = filter.estimate(3);
   const std::vector<std::int64_t> place_nodes = mapper.placeNodes();
   {
     // What the run was made with, for the report's header (and a reader of the run folder).
-    const TopologyFilterConfig& topo = filter->config();
+    const TopologyFilterConfig& topo = filter.config();
     const auto real = [](double v) {
       std::ostringstream text;
       text << v;
@@ -388,31 +398,34 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     out.commit();
   }
 
-  // Nodes and edges of the best topology (over all observations, resumed ones included).
+  // Nodes and edges of the best topology (over all observations, resumed ones included): the topology
+  // stage's snapshot, the one toposlamd publishes. Observations before this run's first are the resumed
+  // map's (`earlier_places`); this run's are its places.
   struct NodeInfo {
     std::vector<std::int64_t> places, representative_frames, earlier_places;
   };
   std::map<int, NodeInfo> nodes;
-  for (std::size_t k = 0; k < assignment.size(); ++k) {
-    NodeInfo& n = nodes[assignment[k]];
-    if (static_cast<int>(k) < first_observation) {
-      n.earlier_places.push_back(static_cast<std::int64_t>(k));
-    } else {
-      const std::size_t p = k - static_cast<std::size_t>(first_observation);
-      n.places.push_back(static_cast<std::int64_t>(p));
-      n.representative_frames.push_back(all.places[p].representative_frame);
+  const TopologySnapshot best = topology->topology();
+  for (const TopologyNode& node : best.nodes) {
+    if (node.places.empty()) continue;
+    NodeInfo& n = nodes[node.id];
+    for (std::size_t i = 0; i < node.places.size(); ++i) {
+      if (node.places[i] < first_observation) {
+        n.earlier_places.push_back(node.places[i]);
+      } else {
+        n.places.push_back(node.places[i] - first_observation);
+        n.representative_frames.push_back(node.representative_frames[i]);
+      }
     }
   }
   std::map<std::pair<int, int>, int> edges;
-  for (std::size_t k = 1; k < assignment.size(); ++k) {
-    if (assignment[k] != assignment[k - 1]) ++edges[{assignment[k - 1], assignment[k]}];
-  }
+  for (const TopologyEdge& edge : best.edges) edges[{edge.from, edge.to}] = edge.count;
   {
     OutputFile out = openOutput(out_dir / "topology.json");
     JsonWriter json(out);
     json.beginObject();
     json.field("probability", final_estimate.best.probability);
-    json.field("particles", filter->config().particles);
+    json.field("particles", filter.config().particles);
     json.field("current_node", final_estimate.current_node);
     json.field("current_node_probability", final_estimate.current_node_probability);
     json.field("effective_sample_size", final_estimate.effective_sample_size);

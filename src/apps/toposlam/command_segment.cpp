@@ -23,6 +23,8 @@
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/thread_os.hpp"
+#include "toposlam/pipeline/algorithm_stages.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -54,19 +56,20 @@ void runSegment(const SegmentOptions& o) {
   std::unique_ptr<FrameSource> source = openSource(o.source);
   std::unique_ptr<WorkerPool> pool;
   if (o.workers > 1) pool = std::make_unique<WorkerPool>(o.workers, namedWorkers("segment"));
-  const VpackExtractor extractor(vpack, pool.get());
+  VpackFingerprintStage fingerprint_stage(vpack, pool.get());
   const NgramSimilarity similarity(preset.similarity);
-  OfflineSegmentation pipeline(extractor, similarity, config);
+  // The daemon's stages without the topology one; thumbnails are the daemon's (place events), none here.
+  FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
+  OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
 
   const std::int64_t total = source->frameCountHint();
   if (!o.quiet) std::cerr << "segment: " << source->describe() << "\n";
   std::vector<double> fingerprint_ms, segment_ms;
   std::vector<FrameTiming> timing;
   std::int64_t refused = 0;
-  // The window's clock: the frames' timestamps with any step back cut out (docs/reliability.md, "Clock
-  // jumps"); frames.csv records it. Motion is looked up at the frame's own timestamp (the motion file's
-  // clock is the recording's).
-  FrameTimeline timeline;
+  // The window's clock: the frames' timestamps with any step back cut out (the segmentation stage's;
+  // docs/reliability.md, "Clock jumps"); frames.csv records it. Motion is looked up at the frame's own
+  // timestamp (the motion file's clock is the recording's).
   Progress progress("segment", "frames", o.max_frames > 0 && (total <= 0 || total > o.max_frames) ? o.max_frames : total,
                     o.quiet);
   std::int64_t read = 0;
@@ -77,7 +80,7 @@ void runSegment(const SegmentOptions& o) {
     Stopwatch fingerprint_watch;
     std::shared_ptr<const Fingerprint> fingerprint;
     try {
-      fingerprint = pipeline.fingerprint(frame->image);
+      fingerprint = pipeline.fingerprint(frame->image, frame->grey);
     } catch (const std::invalid_argument& e) {
       // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
       progress.clearLine();
@@ -87,16 +90,16 @@ void runSegment(const SegmentOptions& o) {
     }
     fingerprint_ms.push_back(fingerprint_watch.elapsedMs());
     Stopwatch segment_watch;
-    const MotionState moving = motion ? motion->at(frame->timestamp_s) : MotionState{};
-    const SegmenterStep step =
-        pipeline.segment(timeline.place(frame->timestamp_s), frame->name, std::move(fingerprint), moving);
+    if (motion) motion->feedUpTo(frame->timestamp_s, segmentation_stage);
+    pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
     segment_ms.push_back(segment_watch.elapsedMs());
     timing.push_back(FrameTiming{fingerprint_ms.back(), segment_ms.back(), std::nullopt});
   }
   pipeline.finish();
   progress.finish();
-  if (timeline.stepsBack() > 0) std::cerr << timelineSummary(timeline, "segment") << "\n";
-  if (motion) std::cerr << motionSummary(*motion, o.motion, "segment") << "\n";
+  if (const FrameTimeline& timeline = segmentation_stage.sourceTimeline(); timeline.stepsBack() > 0)
+    std::cerr << timelineSummary(timeline, "segment") << "\n";
+  if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "segment") << "\n";
 
   const SegmentationRun& run = pipeline.run();
   if (run.frames.empty()) {

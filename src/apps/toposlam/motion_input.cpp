@@ -68,27 +68,21 @@ std::optional<MotionReplay> openMotion(const MotionOptions& options, std::size_t
   config.window_m = options.window_m;
   if (const std::string problem = config.validate(); !problem.empty()) throw std::invalid_argument(command + ": " + problem);
   if (options.file.empty()) return std::nullopt;
-  return MotionReplay(readMotionCsv(options.file), MotionGateConfig{});
+  return MotionReplay(readMotionCsv(options.file));
 }
 
-std::string motionSummary(const MotionReplay& replay, const MotionOptions& options, const std::string& command) {
-  std::string text = command + ": motion from " + options.file + ": " + std::to_string(replay.gate().samples()) +
-                     " samples, " + std::to_string(replay.standingFrames()) + " frames taken standing (not segmented)";
-  if (replay.gate().rejectedSamples() > 0) text += ", " + std::to_string(replay.gate().rejectedSamples()) + " samples refused";
+std::string motionSummary(const FiedlerSegmentationStage& stage, const MotionOptions& options, const std::string& command) {
+  std::string text = command + ": motion from " + options.file + ": " + std::to_string(stage.motionSamples()) +
+                     " samples, " + std::to_string(stage.skippedFrames()) + " frames taken standing (not segmented)";
+  if (stage.refusedMotionSamples() > 0) text += ", " + std::to_string(stage.refusedMotionSamples()) + " samples refused";
   return text;
 }
 
-MotionReplay::MotionReplay(std::vector<MotionCsvSample> samples, const MotionGateConfig& config)
-    : samples_(std::move(samples)), gate_(config) {}
-
-MotionState MotionReplay::at(double frame_time_s) {
+void MotionReplay::feedUpTo(double frame_time_s, FiedlerSegmentationStage& stage) {
   while (next_ < samples_.size() && samples_[next_].time_s <= frame_time_s) {
     const MotionCsvSample& s = samples_[next_++];
-    gate_.addSample(s.time_s, s.distance_m, s.speed_mps, s.turn_rate_rps);
+    stage.addMotion(MotionSample{s.time_s, s.distance_m, s.speed_mps, s.turn_rate_rps});
   }
-  const MotionState state = gate_.at(frame_time_s);
-  if (state.known && state.standing) ++standing_frames_;
-  return state;
 }
 
 }  // namespace toposlam::cli

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/segmentation/motion_gate.hpp"
 
@@ -27,20 +28,17 @@ struct MotionCsvSample {
 /// and line for a missing file, a wrong header, a short or non-numeric row, or a time that goes back.
 std::vector<MotionCsvSample> readMotionCsv(const std::string& path);
 
-/// Feeds a MotionGate the samples in time order up to each frame's time: at(t) adds every sample at or
-/// before t and returns the gate's state at t.
+/// Feeds the segmentation stage's MotionGate (the one toposlamd feeds from TOPOSLAM_MOTION) the samples in
+/// time order up to each frame's time: feedUpTo(t, stage) gives it every sample at or before t not given
+/// yet.
 class MotionReplay {
  public:
-  MotionReplay(std::vector<MotionCsvSample> samples, const MotionGateConfig& config);
-  MotionState at(double frame_time_s);
-  const MotionGate& gate() const { return gate_; }
-  std::int64_t standingFrames() const { return standing_frames_; }
+  explicit MotionReplay(std::vector<MotionCsvSample> samples) : samples_(std::move(samples)) {}
+  void feedUpTo(double frame_time_s, FiedlerSegmentationStage& stage);
 
  private:
   std::vector<MotionCsvSample> samples_;
   std::size_t next_ = 0;
-  MotionGate gate_;
-  std::int64_t standing_frames_ = 0;
 };
 
 /// `--motion FILE` and `--window-m M`, shared by `map` and `segment`.
@@ -53,7 +51,8 @@ void addMotionOptions(CLI::App& command, MotionOptions& options);
 /// std::invalid_argument "<command>: ..." for --window-m without --motion or with several sources.
 std::optional<MotionReplay> openMotion(const MotionOptions& options, std::size_t sources, const std::string& command,
                                        FiedlerSegmenterConfig& config);
-/// "<command>: motion from FILE: N samples, M frames taken standing (not segmented)[, K samples refused]".
-std::string motionSummary(const MotionReplay& replay, const MotionOptions& options, const std::string& command);
+/// "<command>: motion from FILE: N samples, M frames taken standing (not segmented)[, K samples refused]",
+/// from the segmentation stage's counts.
+std::string motionSummary(const FiedlerSegmentationStage& stage, const MotionOptions& options, const std::string& command);
 
 }  // namespace toposlam::cli

@@ -1,4 +1,4 @@
-// OfflineSegmentation's bookkeeping and the run-folder writers (docs/run-folder.md), with fake
+// OfflineMapper's bookkeeping (segmentation only, as `toposlam segment`) and the run-folder writers (docs/run-folder.md), with fake
 // fingerprints and a table similarity: frame rows get their place once it closes, dropped places are
 // -1, CSV headers and columns are exact, the lambda2 plot marks each valley-closed border.
 #include <catch2/catch.hpp>
@@ -9,8 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "fake_similarity.hpp"
+#include "segmentation/fake_similarity.hpp"
 #include "toposlam/eval/run_files.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/segmentation/offline_segmentation.hpp"
 
 using toposlam::test::fakeFingerprint;
@@ -29,13 +30,14 @@ std::vector<std::string> linesOf(const std::string& text) {
 }  // namespace
 
 TEST_CASE(
-    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineSegmentation THEN the rows and "
+    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineMapper THEN the rows and "
     "CSV files follow docs/run-folder.md",
     "[segmentation][run]") {
   auto block = [](int f) { return f < 40 ? 0 : (f < 80 ? 1 : 2); };
   TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
-  const toposlam::VpackExtractor extractor;  // unused: fingerprints are given
-  toposlam::OfflineSegmentation pipeline(extractor, similarity, thesisConfig());
+  toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);  // unused: fingerprints are given
+  toposlam::FiedlerSegmentationStage segmentation_stage(thesisConfig(), similarity, 1);
+  toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
   for (int f = 0; f < 120; ++f) {
     std::string name = "f";
     name.append(std::to_string(f)).append(".png");
@@ -45,7 +47,7 @@ TEST_CASE(
     CHECK(pipeline.run().frames[100].place == -1);
     CHECK(pipeline.run().frames[10].place == 0);
   }
-  REQUIRE(pipeline.finish().has_value());
+  REQUIRE(pipeline.finishTraversal().has_value());
   const toposlam::SegmentationRun& run = pipeline.run();
   REQUIRE(run.places.size() == 2);
   REQUIRE(run.dropped_places.size() == 1);

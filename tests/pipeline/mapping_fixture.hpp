@@ -1,6 +1,6 @@
 // Test fixture for the end-to-end mapping tests: a route's fingerprints (simulated worlds with room
 // labels, or the 84 real sample frames with their loop-closure matrix), computed once per process, and
-// the topology and segmentation scores of one OfflineMapper run over them (src/eval's measures).
+// the topology and segmentation scores of one OfflineMapper run over them (the daemon's stages) (src/eval's measures).
 #pragma once
 
 #include <algorithm>
@@ -17,7 +17,8 @@
 #include "toposlam/eval/metrics.hpp"
 #include "toposlam/eval/run_files.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "toposlam/pipeline/clock.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace toposlam::testing {
@@ -106,11 +107,13 @@ struct MappingScore {
 /// Maps `route` with `config` and the default filter (500 particles, alpha 15) seeded with `seed`.
 inline MappingScore mapRoute(const MappingRoute& route, const FiedlerSegmenterConfig& config,
                              const SimilarityMeasure& similarity, std::uint64_t seed = 1) {
-  const VpackExtractor extractor;
+  VpackFingerprintStage fingerprints(VpackConfig{}, nullptr);  // unused: the route is fingerprinted
+  FiedlerSegmentationStage segmentation(config, similarity, 1);
   TopologyFilterConfig filter_config;
   filter_config.seed = seed;
-  TopologyParticleFilter filter(filter_config, similarity);
-  OfflineMapper mapper(extractor, similarity, config, filter);
+  const ManualClock clock;
+  ParticleFilterTopologyStage topology(filter_config, similarity, clock, TopologyStageConfig{});
+  OfflineMapper mapper(fingerprints, segmentation, &topology);
   for (std::size_t f = 0; f < route.fingerprints.size(); ++f) {
     const auto frame = static_cast<std::int64_t>(f);
     if (route.separate_sources && frame > 0 && std::count(route.traversal_starts.begin(), route.traversal_starts.end(), frame) > 0)
@@ -121,12 +124,12 @@ inline MappingScore mapRoute(const MappingRoute& route, const FiedlerSegmenterCo
   mapper.finish();
 
   MappingScore score;
-  const SegmentationRun run = mapper.run();
+  const SegmentationRun& run = mapper.run();
   const std::vector<std::int64_t> nodes = mapper.placeNodes();
   score.kept = static_cast<int>(run.places.size());
   score.places = run.places;
   score.dropped = static_cast<int>(run.dropped_places.size());
-  score.best_probability = filter.estimate(0).best.probability;
+  score.best_probability = topology.filter().estimate(0).best.probability;
   for (const auto* list : {&run.places, &run.dropped_places}) {
     for (const SegmentedPlace& p : *list) {
       if (p.first_frame > 0 &&

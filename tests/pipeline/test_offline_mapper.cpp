@@ -1,4 +1,4 @@
-// OfflineMapper (the pipeline of `toposlam map`) on hand-made similarities: two traversals (sources) of the
+// OfflineMapper (`toposlam map`'s runner of the daemon's stages) on hand-made similarities: two traversals (sources) of the
 // same three blocks. Checks the run numbering across traversals, one filter step per kept place, and
 // that the second traversal's places land on the first traversal's nodes.
 #include <catch2/catch.hpp>
@@ -6,8 +6,9 @@
 #include <cmath>
 #include <vector>
 
-#include "fake_similarity.hpp"
-#include "toposlam/segmentation/offline_mapper.hpp"
+#include "segmentation/fake_similarity.hpp"
+#include "toposlam/pipeline/clock.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 
 using namespace toposlam;
 using toposlam::test::fakeFingerprint;
@@ -20,9 +21,11 @@ SCENARIO("OfflineMapper maps two traversals of three blocks onto three nodes", "
       if (block(a) != block(b)) return 0.05;
       return 0.9 + 0.05 * std::sin(0.7 * a + 1.3 * b);
     });
-    const VpackExtractor extractor;
-    TopologyParticleFilter filter(TopologyFilterConfig{}, similarity);
-    OfflineMapper mapper(extractor, similarity, test::thesisConfig(), filter);
+    VpackFingerprintStage fingerprints(VpackConfig{}, nullptr);  // unused: fingerprints are made up
+    FiedlerSegmentationStage segmentation(test::thesisConfig(), similarity, 1);
+    const ManualClock clock;
+    ParticleFilterTopologyStage topology(TopologyFilterConfig{}, similarity, clock, TopologyStageConfig{});
+    OfflineMapper mapper(fingerprints, segmentation, &topology);
     std::vector<std::int64_t> closed_frames;
     for (int source = 0; source < 2; ++source) {
       mapper.beginTraversal();
@@ -39,7 +42,7 @@ SCENARIO("OfflineMapper maps two traversals of three blocks onto three nodes", "
         mapper.mapPlace(*last);
       }
     }
-    const SegmentationRun run = mapper.run();
+    const SegmentationRun& run = mapper.run();
     THEN("frames and places are numbered over both traversals, each traversal cut at its block borders") {
       REQUIRE(run.frames.size() == 240);
       CHECK(run.frames[239].frame == 239);
@@ -55,7 +58,7 @@ SCENARIO("OfflineMapper maps two traversals of three blocks onto three nodes", "
     THEN("one filter step per kept place, and the second traversal closes the loop onto the same nodes") {
       REQUIRE(mapper.steps().size() == 6);
       CHECK(mapper.steps()[3].place.first_frame == 120);
-      CHECK(filter.observationCount() == 6);
+      CHECK(topology.observations() == 6);
       const std::vector<std::int64_t> nodes = mapper.placeNodes();
       CHECK(nodes == std::vector<std::int64_t>{0, 1, 2, 0, 1, 2});
     }

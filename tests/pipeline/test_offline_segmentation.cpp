@@ -1,5 +1,6 @@
 // End to end on real frames: the 84 bundled sample frames (a corridor loop, ~1 Hz keyframes) through
-// VPACK (ORB) -> n-gram similarity -> FiedlerSegmenter, and the run-folder writers.
+// VPACK (ORB) -> n-gram similarity -> FiedlerSegmenter, as `toposlam segment` runs them (OfflineMapper
+// driving the daemon's stages), and the run-folder writers.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -12,7 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "toposlam/matching/ngram_similarity.hpp"
-#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/pipeline/offline_mapper.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace {
@@ -35,14 +36,15 @@ TEST_CASE(
     "is sane for the window",
     "[segmentation][e2e]") {
   const std::vector<cv::Mat> frames = loadSamples();
-  const toposlam::VpackExtractor extractor;
   const toposlam::NgramSimilarity similarity;
 
   SECTION(
       "default window (30 frames, 30 s here): the window spans three quarters of the 40-frame lap, lambda2 "
       "stays in [0.55, 0.95], one place") {
     REQUIRE(toposlam::FiedlerSegmenterConfig{}.window == 30);
-    toposlam::OfflineSegmentation pipeline(extractor, similarity, {});
+    toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
+    toposlam::FiedlerSegmentationStage segmentation_stage(toposlam::FiedlerSegmenterConfig{}, similarity, 1);
+    toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
     for (std::size_t i = 0; i < frames.size(); ++i)
       pipeline.process(frames[i], static_cast<double>(i), std::to_string(i + 1) + ".jpg");
     pipeline.finish();
@@ -63,7 +65,9 @@ TEST_CASE(
   SECTION("window 5 (5 s at 1 Hz, the thesis' 25 frames at 5 fps): six places, a border repeated a lap later") {
     toposlam::FiedlerSegmenterConfig config;
     config.window = 5;
-    toposlam::OfflineSegmentation pipeline(extractor, similarity, config);
+    toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
+    toposlam::FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
+    toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
     for (std::size_t i = 0; i < frames.size(); ++i) pipeline.process(frames[i], static_cast<double>(i));
     pipeline.finish();
     const toposlam::SegmentationRun& run = pipeline.run();
@@ -94,12 +98,13 @@ const SimRun& simulatedOfficeRun() {
     sim_config.world = "office";
     sim_config.route = "loop2";
     toposlam::sim::Simulator simulator(sim_config);
-    const toposlam::VpackExtractor extractor;
     const toposlam::NgramSimilarity similarity;
     toposlam::FiedlerSegmenterConfig thesis;  // window 25, gamma 0.5, delta 0.25
     thesis.window = 25;
     thesis.valley = {0.5, 0.25};
-    toposlam::OfflineSegmentation pipeline(extractor, similarity, thesis);
+    toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
+    toposlam::FiedlerSegmentationStage segmentation_stage(thesis, similarity, 1);
+    toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
     SimRun result;
     while (auto frame = simulator.next()) {
       pipeline.process(frame->image, frame->truth.time_s);

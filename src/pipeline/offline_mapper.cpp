@@ -1,0 +1,107 @@
+// OfflineMapper: the stage adapters driven in order on one thread, and the run's frame and place rows.
+#include "toposlam/pipeline/offline_mapper.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+namespace toposlam {
+
+OfflineMapper::OfflineMapper(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
+                             ParticleFilterTopologyStage* topology)
+    : fingerprint_(fingerprint),
+      segmentation_(segmentation),
+      topology_(topology),
+      first_observation_(topology != nullptr ? topology->observations() : 0) {}
+
+void OfflineMapper::beginTraversal() {
+  if (open_) finish();
+  segmentation_.beginTraversal();
+  ++traversal_count_;
+  open_ = true;
+}
+
+std::shared_ptr<const Fingerprint> OfflineMapper::fingerprint(const cv::Mat& image, const cv::Mat& grey) {
+  return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey));
+}
+
+SegmenterStep OfflineMapper::segment(double source_time_s, const std::string& name,
+                                     std::shared_ptr<const Fingerprint> fingerprint) {
+  if (!open_) beginTraversal();
+  SegmentationFrameRecord row;
+  row.frame = static_cast<std::int64_t>(run_.frames.size());
+  row.name = name;
+  row.keypoints = fingerprint ? fingerprint->keypointCount() : 0;
+  // The offline run has no pipeline clock: motion is looked up at the frame's own time, the motion file's.
+  SegmentationStep stage_step = segmentation_.process(row.frame, source_time_s, source_time_s, std::move(fingerprint), cv::Mat());
+  row.time_s = segmentation_.lastFrameTimeS();
+  SegmenterStep step;
+  step.frame = row.frame;
+  if (!std::isnan(stage_step.lambda2)) step.lambda2 = stage_step.lambda2;
+  row.lambda2 = step.lambda2;
+  run_.frames.push_back(std::move(row));
+  pending_ = std::move(stage_step.closed);
+  if (segmentation_.lastClosedPlace()) {
+    step.closed_place = *segmentation_.lastClosedPlace();
+    record(*step.closed_place);
+  }
+  return step;
+}
+
+std::optional<MappedPlace> OfflineMapper::mapPlace(const SegmentedPlace& place) {
+  if (place.dropped || topology_ == nullptr) return std::nullopt;
+  if (!pending_ || pending_->place != place.index)
+    throw std::logic_error("OfflineMapper::mapPlace: not the kept place the segmentation closed last");
+  topology_->enqueuePlace(*pending_);
+  pending_.reset();
+  while (!topology_->idle()) topology_->advance(std::numeric_limits<double>::infinity());
+  MappedPlace mapped{place, topology_->filter().estimate(3)};
+  mapped.place.representative.reset();
+  steps_.push_back(mapped);
+  return mapped;
+}
+
+std::optional<SegmentedPlace> OfflineMapper::finishTraversal() {
+  if (!open_) return std::nullopt;
+  open_ = false;
+  pending_ = segmentation_.finish();
+  const std::optional<SegmentedPlace>& last = segmentation_.lastClosedPlace();
+  if (last) record(*last);
+  return last;
+}
+
+void OfflineMapper::process(const cv::Mat& image, double source_time_s, const std::string& name) {
+  const SegmenterStep step = segment(source_time_s, name, fingerprint(image));
+  if (step.closed_place) mapPlace(*step.closed_place);
+}
+
+void OfflineMapper::finish() {
+  if (std::optional<SegmentedPlace> last = finishTraversal()) mapPlace(*last);
+}
+
+void OfflineMapper::record(const SegmentedPlace& place) {
+  const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, place.first_frame));
+  const auto end = std::min(run_.frames.size(), static_cast<std::size_t>(place.last_frame + 1));
+  for (std::size_t f = first; f < end; ++f) {
+    run_.frames[f].place = place.dropped ? -1 : place.index;
+    run_.frames[f].in_dropped_place = place.dropped;
+  }
+  (place.dropped ? run_.dropped_places : run_.places).push_back(place);
+}
+
+std::vector<std::int64_t> OfflineMapper::placeNodes() const {
+  std::vector<std::int64_t> nodes;
+  if (topology_ == nullptr) return nodes;
+  // The topology stage's snapshot (the one toposlamd publishes) lists each node's places by observation.
+  const TopologySnapshot best = topology_->topology();
+  nodes.assign(static_cast<std::size_t>(topology_->observations() - first_observation_), -1);
+  for (const TopologyNode& node : best.nodes) {
+    for (const int observation : node.places) {
+      if (observation >= first_observation_) nodes[static_cast<std::size_t>(observation - first_observation_)] = node.id;
+    }
+  }
+  return nodes;
+}
+
+}  // namespace toposlam
