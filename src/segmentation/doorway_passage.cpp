@@ -50,7 +50,9 @@ void DoorwayPassageDetector::addFrame(double time_s, int image_width, const std:
     tracks_.clear();
     exits_.clear();
     passages_.clear();
+    frame_interval_s_ = 0.0;
   }
+  if (started_ && time_s > last_time_s_) frame_interval_s_ = time_s - last_time_s_;
   started_ = true;
   last_time_s_ = time_s;
   if (image_width <= 0) return;
@@ -142,7 +144,9 @@ void DoorwayPassageDetector::endTrack(const Track& track, double half_width) {
   for (const Exit& other : exits_) {
     if (other.side == exit.side || std::abs(other.last_s - exit.last_s) > config_.max_exit_gap_s) continue;
     const double still_to_go = std::max(0.0, std::min(exit.passage_s, other.passage_s) - std::max(exit.last_s, other.last_s));
-    const double tolerance = std::max(config_.pair_tolerance_s, config_.pair_tolerance_fraction * still_to_go);
+    // Two frame intervals at least: at 2 fps a track is three frames a second apart, and so is its fit.
+    const double tolerance = std::max({config_.pair_tolerance_s, 2.0 * frame_interval_s_,
+                                       config_.pair_tolerance_fraction * still_to_go});
     if (std::abs(other.passage_s - exit.passage_s) <= tolerance) {
       recordPassage(0.5 * (other.passage_s + exit.passage_s));
       break;

@@ -44,7 +44,8 @@ struct DoorwayPassageConfig {
   /// A passage predicted further ahead than this (seconds after the track's last frame) is ignored: an
   /// edge far away that merely drifts out.
   double max_lookahead_s = 3.0;
-  /// A left and a right prediction agree when they differ by at most this (seconds) ...
+  /// A left and a right prediction agree when they differ by at most this (seconds; at least two frame
+  /// intervals) ...
   double pair_tolerance_s = 0.8;
   /// ... or by at most this fraction of the time still to go from the later track's last frame.
   double pair_tolerance_fraction = 0.5;
@@ -103,6 +104,7 @@ class DoorwayPassageDetector {
   std::vector<Exit> exits_;
   std::vector<double> passages_;  ///< ascending
   double last_time_s_ = 0.0;
+  double frame_interval_s_ = 0.0;  ///< between the last two frames
   bool started_ = false;
   std::int64_t passage_count_ = 0;
 };
