@@ -522,8 +522,8 @@ void FiedlerSegmenter::moveBorderToDoorway() {
   const std::optional<double> passage = doorway_.nearestPassage(pending_border_time_s_, config_.doorway_shift_s);
   if (!passage) return;
   // The first recent frame at or after the passage, and the one before it (the closing place's last).
-  // A passage still ahead (predicted less than a second before the robot gets there) takes the newest
-  // frame: a place cannot start at a frame not seen yet.
+  // A passage still ahead (predicted before the robot gets there) takes the newest frame: a place
+  // cannot start at a frame not seen yet.
   const std::size_t size = recent_frame_.size();
   const std::size_t oldest = recent_count_ < size ? 0 : recent_next_;
   std::int64_t border = -1, last = -1;
@@ -555,7 +555,7 @@ void FiedlerSegmenter::moveBorderToDoorway() {
   if (!has_candidate) return;
   // The representatives stay within the borders found by appearance: the frames a shift moves into a
   // place look like its neighbour (the room seen through the door, the corridor seen on the way out).
-  representative_last_ = std::min(pending_last_frame_, last);
+  representative_last_ = to;
   next_representative_from_ = std::max(border, pending_border_frame_);
   pending_border_frame_ = border;
   pending_border_time_s_ = border_time;
