@@ -420,6 +420,10 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("segmentation.doorway_shift_s", AT(segmentation.doorway_shift_s), 7.0, 0, 60, "seconds",
                    "a border moves to the doorway passage nearest it (predicted from the vertical edges) when one is "
                    "at most this far (0 = off, the thesis)"));
+  k.push_back(flag("segmentation.doorway_borders", AT(segmentation.doorway_borders), false,
+                   "with doorway_shift_s > 0: a doorway passage makes a border of its own, and a second border for "
+                   "the passage a place began at is dropped (off: a wrong closure kept on look-alike rooms; "
+                   "docs/segmentation.md)"));
   k.push_back(choice("segmentation.representative", AT(segmentation.representative), RepresentativeChoice::WindowDegree,
                      {{"window-degree", RepresentativeChoice::WindowDegree},
                       {"place-medoid", RepresentativeChoice::PlaceMedoid}},

@@ -166,6 +166,12 @@ void DoorwayPassageDetector::recordPassage(double passage_s) {
   ++passage_count_;
 }
 
+std::optional<double> DoorwayPassageDetector::firstPassageAfter(double after_s) const {
+  const auto it = std::upper_bound(passages_.begin(), passages_.end(), after_s);
+  if (it == passages_.end()) return std::nullopt;
+  return *it;
+}
+
 std::optional<double> DoorwayPassageDetector::nearestPassage(double time_s, double max_distance_s) const {
   std::optional<double> best;
   for (const double passage : passages_) {

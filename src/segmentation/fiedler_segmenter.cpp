@@ -461,6 +461,9 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
     place_start_time_s_ = time_s;
   }
   if (config_.doorway_shift_s > 0.0) {
+    // A time that does not increase is a new traversal: the detector forgets its passages.
+    if (recent_count_ > 0 && !(time_s > recent_time_[(recent_next_ + recent_frame_.size() - 1) % recent_frame_.size()]))
+      passages_done_s_ = -std::numeric_limits<double>::infinity();
     const Fingerprint& added = *slot_fingerprint_[s];
     doorway_.addFrame(time_s, added.image_width, added.edge_columns);
     recent_frame_[recent_next_] = frame_index;
@@ -506,8 +509,13 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
     }
     if (valley) {
       if (pending_min_frame_ == *valley && pending_border_frame_ > place_start_) {
-        if (config_.doorway_shift_s > 0.0) moveBorderToDoorway();
-        step.closed_place = closePlace(*valley, pending_border_frame_, pending_border_time_s_);
+        if (config_.doorway_shift_s <= 0.0 || moveBorderToDoorway()) {
+          step.closed_place = closePlace(*valley, pending_last_frame_, pending_last_time_s_, pending_border_frame_,
+                                         pending_border_time_s_, pending_border_passage_s_);
+        } else {
+          ++ignored_valleys_;
+          ++doorway_repeats_;
+        }
       } else {
         ++ignored_valleys_;
       }
@@ -515,62 +523,104 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
       pending_border_frame_ = -1;
     }
   }
+  // A doorway passage the frames have reached closes the open place there, unless a border is already
+  // on it (one passage per frame; a place closed by a valley in this frame makes it wait for the next).
+  if (config_.doorway_shift_s > 0.0 && config_.doorway_borders && !step.closed_place) {
+    const std::optional<double> due = doorway_.firstPassageAfter(passages_done_s_);
+    if (due && time_s >= *due) {
+      passages_done_s_ = *due;
+      step.closed_place = closePlaceAtPassage(*due);
+    }
+  }
   return step;
 }
 
-void FiedlerSegmenter::moveBorderToDoorway() {
-  const std::optional<double> passage = doorway_.nearestPassage(pending_border_time_s_, config_.doorway_shift_s);
-  if (!passage) return;
-  // The first recent frame at or after the passage, and the one before it (the closing place's last).
-  // A passage still ahead (predicted before the robot gets there) takes the newest frame: a place
+FiedlerSegmenter::RecentBorder FiedlerSegmenter::recentBorderAt(double time_s) const {
+  // The first recent frame at or after time_s, and the one before it (the closing place's last). A
+  // time still ahead (a passage predicted before the robot gets there) takes the newest frame: a place
   // cannot start at a frame not seen yet.
+  RecentBorder at;
   const std::size_t size = recent_frame_.size();
   const std::size_t oldest = recent_count_ < size ? 0 : recent_next_;
-  std::int64_t border = -1, last = -1;
-  double border_time = 0.0, last_time = 0.0;
   for (std::size_t k = 0; k < recent_count_; ++k) {
     const std::size_t i = (oldest + k) % size;
-    if (recent_time_[i] >= *passage) {
-      border = recent_frame_[i];
-      border_time = recent_time_[i];
-      break;
+    if (recent_time_[i] >= time_s) {
+      at.border = recent_frame_[i];
+      at.border_time_s = recent_time_[i];
+      return at;
     }
-    last = recent_frame_[i];
-    last_time = recent_time_[i];
+    at.last = recent_frame_[i];
+    at.last_time_s = recent_time_[i];
   }
-  if (border < 0 && recent_count_ >= 2) {
+  if (recent_count_ >= 2) {
     const std::size_t newest = (recent_next_ + size - 1) % size;
     const std::size_t before = (recent_next_ + size - 2) % size;
-    border = recent_frame_[newest];
-    border_time = recent_time_[newest];
-    last = recent_frame_[before];
-    last_time = recent_time_[before];
+    at.border = recent_frame_[newest];
+    at.border_time_s = recent_time_[newest];
+    at.last = recent_frame_[before];
+    at.last_time_s = recent_time_[before];
   }
-  if (border < 0 || last < 0 || border <= place_start_ || border == pending_border_frame_) return;
+  return at;
+}
+
+std::optional<SegmentedPlace> FiedlerSegmenter::closePlaceAtPassage(double passage_s) {
+  // A border already on this passage (a valley's, moved to it), a passage before the open place, or
+  // one older than the recent frames: nothing to close.
+  if (passage_s == place_start_passage_s_) return std::nullopt;
+  const RecentBorder at = recentBorderAt(passage_s);
+  if (at.border < 0 || at.last < 0 || at.border <= place_start_) return std::nullopt;
+  rememberBestWindowFrame(place_start_, at.border);
+  const std::int64_t from = std::max(place_start_, representative_from_);
+  const std::int64_t to = std::min(at.last, representative_last_);
+  if (!hasCandidateIn(from, to)) return std::nullopt;
+  SegmentedPlace place = closePlace(at.border, at.last, at.last_time_s, at.border, at.border_time_s, passage_s);
+  ++doorway_borders_;
+  return place;
+}
+
+bool FiedlerSegmenter::hasCandidateIn(std::int64_t from, std::int64_t to) const {
+  return std::any_of(candidates_.begin(), candidates_.end(),
+                     [&](const Candidate& c) { return c.frame >= from && c.frame <= to; });
+}
+
+bool FiedlerSegmenter::moveBorderToDoorway() {
+  pending_border_passage_s_ = std::numeric_limits<double>::quiet_NaN();
+  const std::optional<double> passage = doorway_.nearestPassage(pending_border_time_s_, config_.doorway_shift_s);
+  if (!passage) return true;
+  if (config_.doorway_borders && *passage == place_start_passage_s_) {
+    // The open place began at this doorway: a second border for it is where the view changes again
+    // after the door (the robot turning into the corridor). Dropped; the place's representative comes
+    // from the frames after it, the view the place settles on.
+    representative_from_ = std::max(representative_from_, pending_border_frame_);
+    return false;
+  }
+  const RecentBorder at = recentBorderAt(*passage);
+  const std::int64_t border = at.border, last = at.last;
+  if (border < 0 || last < 0 || border <= place_start_ || border == pending_border_frame_) return true;
   const std::int64_t from = std::max(place_start_, representative_from_);
   const std::int64_t to = std::min(pending_last_frame_, last);
-  const bool has_candidate = std::any_of(candidates_.begin(), candidates_.end(), [&](const Candidate& c) {
-    return c.frame >= from && c.frame <= to;
-  });
-  if (!has_candidate) return;
+  if (!hasCandidateIn(from, to)) return true;
   // The representatives stay within the borders found by appearance: the frames a shift moves into a
   // place look like its neighbour (the room seen through the door, the corridor seen on the way out).
   representative_last_ = to;
   next_representative_from_ = std::max(border, pending_border_frame_);
   pending_border_frame_ = border;
-  pending_border_time_s_ = border_time;
+  pending_border_time_s_ = at.border_time_s;
   pending_last_frame_ = last;
-  pending_last_time_s_ = last_time;
+  pending_last_time_s_ = at.last_time_s;
   ++doorway_shifts_;
+  pending_border_passage_s_ = *passage;
+  return true;
 }
 
-SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
-                                            double next_start_time_s) {
+SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int64_t last_frame_of_place,
+                                            double last_time_s, std::int64_t next_start_frame,
+                                            double next_start_time_s, double next_start_passage_s) {
   SegmentedPlace place;
   place.first_frame = place_start_;
   place.first_time_s = place_start_time_s_;
-  place.last_frame = valley_frame < 0 ? last_frame_ : pending_last_frame_;
-  place.last_time_s = valley_frame < 0 ? last_time_s_ : pending_last_time_s_;
+  place.last_frame = last_frame_of_place;
+  place.last_time_s = last_time_s;
   place.valley_frame = valley_frame;
   const std::int64_t last_frame = place.last_frame;
   // Representative candidates: the place's frames, within the borders found by appearance when a
@@ -614,13 +664,14 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
   next_representative_from_ = -1;
   place_start_ = next_start_frame;
   place_start_time_s_ = next_start_time_s;
+  place_start_passage_s_ = next_start_passage_s;
   return place;
 }
 
 std::optional<SegmentedPlace> FiedlerSegmenter::flush() {
   if (place_start_ < 0 || place_start_ > last_frame_) return std::nullopt;
   rememberBestWindowFrame(place_start_, last_frame_ + 1);
-  SegmentedPlace place = closePlace(-1, -1, 0.0);
+  SegmentedPlace place = closePlace(-1, last_frame_, last_time_s_, -1, 0.0, std::numeric_limits<double>::quiet_NaN());
   place_start_ = -1;  // the next frame added opens a new place
   pending_min_frame_ = -1;
   pending_border_frame_ = -1;

@@ -155,7 +155,8 @@ class HeightTable : public toposlam::SimilarityMeasure {
 };
 
 /// Two blocks by appearance (frames 0-39 and 40-99), a door passed at `door_frame`.
-std::vector<SegmentedPlace> segmentWithDoor(double shift_s, int door_frame, FiedlerSegmenter** out = nullptr) {
+std::vector<SegmentedPlace> segmentWithDoor(double shift_s, int door_frame, FiedlerSegmenter** out = nullptr,
+                                            bool doorway_borders = false) {
   // Frames 40-44, just past the appearance border, look like everything around (the room through
   // the door, seen from the corridor): the largest degree of any window, a bad representative.
   static const HeightTable similarity([](int a, int b) {
@@ -166,6 +167,7 @@ std::vector<SegmentedPlace> segmentWithDoor(double shift_s, int door_frame, Fied
   });
   FiedlerSegmenterConfig config = toposlam::test::thesisConfig();
   config.doorway_shift_s = shift_s;
+  config.doorway_borders = doorway_borders;
   static std::unique_ptr<FiedlerSegmenter> keep;
   keep = std::make_unique<FiedlerSegmenter>(config, similarity);
   std::vector<SegmentedPlace> places;
@@ -213,5 +215,152 @@ TEST_CASE("GIVEN a border by appearance near a doorway passage WHEN segmented TH
     CHECK(places[1].first_frame == 40);
     CHECK(segmenter->doorwayPassages() == 1);
     CHECK(segmenter->doorwayShifts() == 0);
+  }
+}
+
+TEST_CASE("GIVEN doorway_borders and a border by appearance near a passage WHEN segmented THEN one border, at the door",
+          "[segmentation][doorway]") {
+  FiedlerSegmenter* segmenter = nullptr;
+  SECTION("the door 10 frames (2 s) after the appearance border, reached before the valley is confirmed") {
+    // The passage closes the place when the robot reaches the door; the valley confirmed later has its
+    // border inside the closed place and is ignored.
+    const auto places = segmentWithDoor(7.0, 50, &segmenter, true);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(50).margin(1));
+    CHECK(places[0].last_frame == places[1].first_frame - 1);
+    CHECK(segmenter->doorwayBorders() == 1);
+    CHECK(segmenter->doorwayShifts() == 0);
+    CHECK(segmenter->ignoredValleys() == 1);
+  }
+  SECTION("the door 26 frames (5.2 s) after the appearance border, predicted when the valley is confirmed") {
+    // The valley closes the place before the robot reaches the door: its border moves towards the
+    // predicted passage, to the newest frame (a place cannot begin at a frame not seen yet).
+    const auto places = segmentWithDoor(7.0, 66, &segmenter, true);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame > 56);
+    CHECK(places[1].first_frame <= 66);
+    CHECK(places[0].last_frame == places[1].first_frame - 1);
+    CHECK(segmenter->doorwayShifts() == 1);
+    CHECK(segmenter->doorwayBorders() == 0);
+    THEN("the representatives stay inside the borders found by appearance") {
+      CHECK(places[0].representative_frame < 40);
+      CHECK(places[1].representative_frame >= 40);
+    }
+  }
+  SECTION("the door 8 frames before the appearance border: the place ends at the door") {
+    const auto places = segmentWithDoor(7.0, 32, &segmenter, true);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(32).margin(1));
+    CHECK(places[0].representative_frame < 32);
+    CHECK(places[1].representative_frame >= 40);
+  }
+  SECTION("a door further away than doorway_shift_s: the border stays, and the door makes its own") {
+    const auto places = segmentWithDoor(1.0, 80, &segmenter, true);
+    REQUIRE(places.size() == 3);
+    CHECK(places[1].first_frame == 40);
+    CHECK(places[2].first_frame == Approx(80).margin(1));
+    CHECK(places[1].last_frame == places[2].first_frame - 1);
+    CHECK(segmenter->doorwayPassages() == 1);
+    CHECK(segmenter->doorwayShifts() == 0);
+    CHECK(segmenter->doorwayBorders() == 1);
+  }
+}
+
+namespace {
+
+/// Appearance blocks beginning at `block_starts` (frames of one block alike, of two blocks not), doors
+/// passed at `doors` (each door's jambs seen from 30 frames before it), 100 frames at 5 fps.
+std::vector<SegmentedPlace> segmentBlocks(double shift_s, const std::vector<int>& block_starts,
+                                          const std::vector<int>& doors, FiedlerSegmenter** out) {
+  const auto blockOf = [block_starts](int f) {
+    return static_cast<int>(std::upper_bound(block_starts.begin(), block_starts.end(), f) - block_starts.begin());
+  };
+  static std::unique_ptr<HeightTable> similarity;
+  similarity = std::make_unique<HeightTable>([blockOf](int a, int b) {
+    if (blockOf(a) != blockOf(b)) return 0.05;
+    return 0.9 + 0.05 * std::sin(0.7 * a + 1.3 * b);
+  });
+  FiedlerSegmenterConfig config = toposlam::test::thesisConfig();
+  config.doorway_shift_s = shift_s;
+  config.doorway_borders = true;
+  static std::unique_ptr<FiedlerSegmenter> keep;
+  keep = std::make_unique<FiedlerSegmenter>(config, *similarity);
+  std::vector<SegmentedPlace> places;
+  for (int f = 0; f < 100; ++f) {
+    auto fingerprint = std::make_shared<Fingerprint>();
+    fingerprint->image_width = kWidth;
+    fingerprint->image_height = f;
+    fingerprint->keypoints.resize(50);
+    for (const int door : doors) {
+      if (door >= f && door - f <= 30) {
+        fingerprint->edge_columns = edgesAt({-0.45, -0.40, 0.40, 0.45}, 0.1 * (door - f));
+        break;
+      }
+    }
+    if (auto step = keep->addFrame(f, 0.2 * f, fingerprint); step.closed_place) places.push_back(*step.closed_place);
+  }
+  if (auto last = keep->flush()) places.push_back(*last);
+  *out = keep.get();
+  return places;
+}
+
+std::vector<std::int64_t> firstFrames(const std::vector<SegmentedPlace>& places) {
+  std::vector<std::int64_t> out;
+  for (const SegmentedPlace& p : places) out.push_back(p.first_frame);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a doorway passage and no border by appearance WHEN segmented THEN the passage makes the border",
+          "[segmentation][doorway]") {
+  FiedlerSegmenter* segmenter = nullptr;
+  SECTION("off (the thesis): one place, the view never changes") {
+    CHECK(segmentBlocks(0.0, {}, {50}, &segmenter).size() == 1);
+  }
+  SECTION("on: the place changes at the door") {
+    const auto places = segmentBlocks(8.0, {}, {50}, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(50).margin(1));
+    CHECK(places[0].last_frame == places[1].first_frame - 1);
+    CHECK(places[0].representative_frame < places[1].first_frame);
+    CHECK(places[1].representative_frame >= places[1].first_frame);
+    CHECK(segmenter->doorwayBorders() == 1);
+    CHECK(segmenter->ignoredValleys() == 0);
+  }
+  SECTION("two doors: two borders, each at its door") {
+    const auto places = segmentBlocks(8.0, {}, {35, 70}, &segmenter);
+    REQUIRE(places.size() == 3);
+    CHECK(places[1].first_frame == Approx(35).margin(1));
+    CHECK(places[2].first_frame == Approx(70).margin(1));
+    CHECK(segmenter->doorwayBorders() == 2);
+  }
+}
+
+TEST_CASE("GIVEN two borders by appearance for one doorway WHEN segmented THEN the second is dropped",
+          "[segmentation][doorway]") {
+  // The door at 36 closes a place when the robot reaches it; the view changes at 40 and again at 70, 6.8
+  // s after the door: the robot turning into the corridor after the doorway, not a second room change.
+  FiedlerSegmenter* segmenter = nullptr;
+  SECTION("off (the thesis): three places, where the view changes") {
+    const auto places = segmentBlocks(0.0, {40, 70}, {36}, &segmenter);
+    CHECK(firstFrames(places) == std::vector<std::int64_t>{0, 40, 70});
+  }
+  SECTION("on: two places, one border at the door") {
+    const auto places = segmentBlocks(8.0, {40, 70}, {36}, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(36).margin(1));
+    CHECK(segmenter->doorwayBorders() == 1);
+    CHECK(segmenter->doorwayRepeats() == 2);  // the borders at 40 and at 70
+    THEN("the place's representative is from the view it settles on, after the dropped border") {
+      CHECK(places[1].representative_frame >= 70);
+    }
+  }
+  SECTION("a border further from the door than doorway_shift_s stays") {
+    const auto places = segmentBlocks(5.0, {40, 70}, {36}, &segmenter);
+    REQUIRE(places.size() == 3);
+    CHECK(places[1].first_frame == Approx(36).margin(1));
+    CHECK(places[2].first_frame == 70);
+    CHECK(segmenter->doorwayRepeats() == 1);  // the border at 40, 0.8 s after the door
   }
 }

@@ -78,6 +78,8 @@ class DoorwayPassageDetector {
 
   /// Passages recorded so far (including those no longer remembered).
   std::int64_t passageCount() const { return passage_count_; }
+  /// The earliest remembered passage later than `after_s`; none when there is none.
+  std::optional<double> firstPassageAfter(double after_s) const;
 
  private:
   struct Track {

@@ -108,10 +108,16 @@ struct FiedlerSegmenterConfig {
   ValleyDetectorConfig valley{0.5, 0.30};
   int min_keypoints = 15;  ///< places whose representative has fewer keypoints are dropped (thesis: 15)
   CutPlacement cut_placement = CutPlacement::WindowSplit;
-  /// Borders at doorways (docs/segmentation.md, "Borders at doorways"): a border found by appearance
-  /// moves to the doorway passage (DoorwayPassageDetector, from the frames' vertical edges) nearest to
-  /// it when one is at most this many seconds away. Allowed [0, 60]; 0 = off (the thesis).
+  /// Borders at doorways (docs/segmentation.md, "Borders at doorways"), from the doorway passages that
+  /// DoorwayPassageDetector predicts from the frames' vertical edges. When > 0, a border found by
+  /// appearance moves to the passage nearest to it when one is at most this many seconds away. Allowed
+  /// [0, 60]; 0 = off (the thesis).
   double doorway_shift_s = 0.0;
+  /// With doorway_shift_s > 0, passages also make borders: a passage the frames reach closes the open
+  /// place there (unless a border is on it already), and a border whose nearest passage is the one the
+  /// open place began at is dropped (one border per doorway). Off by default (docs/segmentation.md:
+  /// better boundary F1 on the simulated office and home, but a wrong closure kept on look-alike rooms).
+  bool doorway_borders = false;
   /// The representative rule; both prefer frames with at least min_keypoints keypoints.
   RepresentativeChoice representative = RepresentativeChoice::WindowDegree;
   /// PlaceMedoid: the place's frames are sampled at most this often (its first frame always; allowed
@@ -188,8 +194,11 @@ class FiedlerSegmenter {
   std::int64_t skippedFrames() const { return skipped_frames_; }
   /// Frames left out as too close (min_frame_spacing_m / _rad) to the last frame added.
   std::int64_t thinnedFrames() const { return thinned_frames_; }
-  /// Borders moved to a doorway passage (doorway_shift_s), and doorway passages seen.
+  /// doorway_shift_s: borders moved to a doorway passage; doorway_borders: borders dropped because the
+  /// place began at their passage, and places closed by a passage alone; doorway passages seen.
   std::int64_t doorwayShifts() const { return doorway_shifts_; }
+  std::int64_t doorwayRepeats() const { return doorway_repeats_; }
+  std::int64_t doorwayBorders() const { return doorway_borders_; }
   std::int64_t doorwayPassages() const { return doorway_.passageCount(); }
   /// Current cached affinity matrix, rows/columns in window order (oldest first); for tests and plots.
   Eigen::MatrixXd affinityInWindowOrder() const;
@@ -230,10 +239,28 @@ class FiedlerSegmenter {
   void dropPlaceSamples(int count);
   /// doorway_shift_s: moves the pending border to the doorway passage nearest to it, when there is one
   /// and the border stays inside (place start, newest frame] with a representative candidate before it.
-  void moveBorderToDoorway();
-  /// Closes the open place: at the pending border (valley_frame >= 0) or at the newest frame (-1).
-  SegmentedPlace closePlace(std::int64_t valley_frame, std::int64_t next_start_frame,
-                            double next_start_time_s);
+  /// False when the border is to be dropped (doorway_borders: its nearest passage is the one the open
+  /// place began at).
+  bool moveBorderToDoorway();
+  /// doorway_borders: a passage the frames have reached closes the open place at the first recent frame
+  /// at or after it, unless the place began there (a border was moved to it) or after it.
+  std::optional<SegmentedPlace> closePlaceAtPassage(double passage_s);
+  struct RecentBorder {
+    std::int64_t border = -1;  ///< first recent frame at or after the time; -1 = none
+    double border_time_s = 0.0;
+    std::int64_t last = -1;    ///< the recent frame before it; -1 = none
+    double last_time_s = 0.0;
+  };
+  /// The recent frames a border at time_s falls on (the newest two for a time still ahead).
+  RecentBorder recentBorderAt(double time_s) const;
+  /// True when the open place has a representative candidate in [from, to] (and the representative
+  /// bounds of a doorway shift).
+  bool hasCandidateIn(std::int64_t from, std::int64_t to) const;
+  /// Closes the open place with its last frame given: at a border (valley_frame >= 0 for a valley, the
+  /// border itself for a passage) or at the newest frame (-1, a flush). The next place begins at
+  /// next_start_frame, on the doorway passage next_start_passage_s (NaN: on none).
+  SegmentedPlace closePlace(std::int64_t valley_frame, std::int64_t last_frame_of_place, double last_time_s,
+                            std::int64_t next_start_frame, double next_start_time_s, double next_start_passage_s);
 
   FiedlerSegmenterConfig config_;
   const SimilarityMeasure& similarity_;
@@ -288,6 +315,14 @@ class FiedlerSegmenter {
   std::size_t recent_next_ = 0;
   std::size_t recent_count_ = 0;
   std::int64_t doorway_shifts_ = 0;
+  std::int64_t doorway_repeats_ = 0;
+  std::int64_t doorway_borders_ = 0;
+  /// Passages up to this time are handled (reached by the frames); -inf: none yet.
+  double passages_done_s_ = -std::numeric_limits<double>::infinity();
+  /// The passage the open place began at (NaN: it began at no passage).
+  double place_start_passage_s_ = std::numeric_limits<double>::quiet_NaN();
+  /// The passage moveBorderToDoorway moved the pending border to (NaN: not moved).
+  double pending_border_passage_s_ = std::numeric_limits<double>::quiet_NaN();
   // After a doorway shift, the representative is chosen among frames inside the borders found by
   // appearance: [representative_from_, representative_last_] of the open place.
   std::int64_t representative_from_ = -1;

@@ -64,7 +64,7 @@ void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::
 }
 
 namespace {
-enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kDoorwayShift, kRepresentative, kRepresentativeInterval };
+enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kDoorwayShift, kDoorwayBorders, kRepresentative, kRepresentativeInterval };
 }  // namespace
 
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
@@ -120,6 +120,11 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
                          ->capture_default_str()
                          ->check(keyRange("segmentation.doorway_shift_s")),
                      kDoorwayShift);
+  given.emplace_back(command.add_option("--doorway-borders", c.doorway_borders,
+                                        "Segmentation: with --doorway-shift-s > 0, a doorway passage makes a border "
+                                        "of its own and a second border for one doorway is dropped (true/false)")
+                         ->capture_default_str(),
+                     kDoorwayBorders);
   given.emplace_back(command.add_option("--representative", options.representative,
                                         "Segmentation: a place's representative: window-degree (the thesis) or "
                                         "place-medoid (the sampled frame most like the place's others)")
@@ -156,6 +161,7 @@ FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const
       case kMinKeypoints: config.min_keypoints = o.min_keypoints; break;
       case kCut: config.cut_placement = parseCutPlacement(options.cut); break;
       case kDoorwayShift: config.doorway_shift_s = o.doorway_shift_s; break;
+      case kDoorwayBorders: config.doorway_borders = o.doorway_borders; break;
       case kRepresentative: config.representative = parseRepresentativeChoice(options.representative); break;
       case kRepresentativeInterval: config.representative_interval_s = o.representative_interval_s; break;
     }
