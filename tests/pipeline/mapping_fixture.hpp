@@ -15,7 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "toposlam/eval/metrics.hpp"
-#include "toposlam/eval/run_files.hpp"
+#include "toposlam/eval/ground_truth.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/offline_mapper.hpp"

@@ -22,7 +22,7 @@
 
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/stages.hpp"
-#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/segmentation/segmentation_run.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
