@@ -1,4 +1,4 @@
-// OfflineMapper's bookkeeping (segmentation only, as `toposlam segment`) and the run folder made from its rows
+// OfflineRunner's bookkeeping (segmentation only, as `toposlam segment`) and the run folder made from its rows
 // (src/run_folder, docs/run-folder.md), with fake
 // fingerprints and a table similarity: frame rows get their place once it closes, dropped places are
 // -1, CSV headers and columns are exact, the lambda2 plot marks each valley-closed border.
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "segmentation/fake_similarity.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 #include "toposlam/run_folder/run_folder.hpp"
 
 using toposlam::test::fakeFingerprint;
@@ -38,14 +38,14 @@ std::filesystem::path scratchFolder(const std::string& name) {
 }  // namespace
 
 TEST_CASE(
-    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineMapper THEN the rows and "
+    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineRunner THEN the rows and "
     "CSV files follow docs/run-folder.md",
     "[segmentation][run]") {
   auto block = [](int f) { return f < 40 ? 0 : (f < 80 ? 1 : 2); };
   TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
   toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);  // unused: fingerprints are given
   toposlam::FiedlerSegmentationStage segmentation_stage(thesisConfig(), similarity, 1);
-  toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+  toposlam::OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
   for (int f = 0; f < 120; ++f) {
     std::string name = "f";
     name.append(std::to_string(f)).append(".png");

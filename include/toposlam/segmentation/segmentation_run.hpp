@@ -1,5 +1,5 @@
 // The rows of an offline run's segmentation: every frame with its Fiedler value and place, and the kept and
-// dropped places. OfflineMapper (src/pipeline) fills them as it drives the stages: frames numbered 0, 1,
+// dropped places. OfflineRunner (src/pipeline) fills them as it drives the stages: frames numbered 0, 1,
 // 2, ... in stream order, whatever the source's own sequence numbers. Plain data; the run folder's files
 // made from them are run_folder's (toposlam/run_folder/run_folder.hpp).
 #pragma once

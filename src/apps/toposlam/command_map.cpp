@@ -38,7 +38,7 @@
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/programs.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 #include "toposlam/run_folder/run_folder.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/pipeline/map_files.hpp"
@@ -229,7 +229,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   if (const std::string problem = evidence.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
   // Thumbnails are the daemon's (place events); the offline run keeps none.
   FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
-  OfflineMapper mapper(fingerprint_stage, segmentation_stage, topology.get());
+  OfflineRunner runner(fingerprint_stage, segmentation_stage, topology.get());
   std::vector<TimingRow> timing;
   std::int64_t refused = 0;
   // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
@@ -240,7 +240,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (place.dropped) return;
     if (progress != nullptr) progress->clearLine();
     const auto start = std::chrono::steady_clock::now();
-    const MappedPlace mapped = *mapper.mapPlace(place);
+    const MappedPlace mapped = *runner.mapPlace(place);
     if (!timing.empty()) timing.back().filter_ms = *timing.back().filter_ms + msSince(start);
     origins.push_back(ObservationOrigin{run_number, place.representative_frame});
     const TopologyEstimate& e = mapped.estimate;
@@ -253,7 +253,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   for (const std::string& uri : o.sources) {
     std::unique_ptr<FrameSource> source = openSource(uri);
     std::cerr << "map: " << source->describe() << "\n";
-    mapper.beginTraversal();  // fresh segmentation window per traversal
+    runner.beginTraversal();  // fresh segmentation window per traversal
     // Each traversal has its own clock, with any step back inside it cut out (the segmentation stage's;
     // docs/reliability.md, "Clock jumps"); the next source starts its own, so where it goes back a new
     // traversal begins (frames.csv).
@@ -268,7 +268,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       auto start = std::chrono::steady_clock::now();
       std::shared_ptr<const Fingerprint> fingerprint;
       try {
-        fingerprint = mapper.fingerprint(frame->image, frame->grey);
+        fingerprint = runner.fingerprint(frame->image, frame->grey);
       } catch (const std::invalid_argument& e) {
         // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
         if (refused++ == 0) std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
@@ -281,13 +281,13 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
       if (motion) motion->feedUpTo(frame->timestamp_s, segmentation_stage);
-      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint));
+      const SegmenterStep step = runner.segment(frame->timestamp_s, name, std::move(fingerprint));
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
       if (step.closed_place) mapPlace(*step.closed_place);
     }
-    if (auto last = mapper.finishTraversal()) mapPlace(*last);
+    if (auto last = runner.finishTraversal()) mapPlace(*last);
     source_progress.finish();
     progress = nullptr;
     if (source->skippedFrames() > 0)
@@ -296,7 +296,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       std::cerr << timelineSummary(timeline, "map") << "\n";
   }
   if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
-  const SegmentationRun& all = mapper.run();
+  const SegmentationRun& all = runner.run();
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
                              " refused)");
@@ -308,7 +308,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
 
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter.estimate(3);
-  const std::vector<std::int64_t> place_nodes = mapper.placeNodes();
+  const std::vector<std::int64_t> place_nodes = runner.placeNodes();
   {
     // What the run was made with, for the report's header (and a reader of the run folder).
     const TopologyFilterConfig& topo = filter.config();
@@ -358,7 +358,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::vector<std::int64_t> place_of_frame;
     for (const auto& row : all.frames) place_of_frame.push_back(row.place);
     std::vector<double> place_probability(all.places.size(), 0.0);
-    for (const MappedPlace& step : mapper.steps()) {
+    for (const MappedPlace& step : runner.steps()) {
       const auto p = static_cast<std::size_t>(step.place.index);
       if (p < place_probability.size()) place_probability[p] = step.estimate.current_node_probability;
     }
@@ -430,7 +430,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       for (std::int64_t p : info.earlier_places) n.earlier_places.push_back(static_cast<int>(p));
     }
     for (const auto& [edge, count] : edges) file.edges.push_back(TopologyFile::Edge{edge.first, edge.second, count});
-    for (const MappedPlace& s : mapper.steps()) {
+    for (const MappedPlace& s : runner.steps()) {
       TopologyFile::Step& step = file.history.emplace_back();
       step.place = static_cast<int>(s.place.index);
       step.node = s.estimate.current_node;

@@ -23,7 +23,7 @@
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/thread_os.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 #include "toposlam/run_folder/run_folder.hpp"
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -59,7 +59,7 @@ void runSegment(const SegmentOptions& o) {
   const NgramSimilarity similarity(preset.similarity);
   // The daemon's stages without the topology one; thumbnails are the daemon's (place events), none here.
   FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
-  OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+  OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
 
   const std::int64_t total = source->frameCountHint();
   if (!o.quiet) std::cerr << "segment: " << source->describe() << "\n";

@@ -33,11 +33,11 @@ struct MappedPlace {
   TopologyEstimate estimate;
 };
 
-class OfflineMapper {
+class OfflineRunner {
  public:
-  /// The stages must outlive the mapper. `topology` may already hold observations (a resumed map); null:
+  /// The stages must outlive the runner. `topology` may already hold observations (a resumed map); null:
   /// segmentation only (`toposlam segment`), mapPlace() does nothing.
-  OfflineMapper(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
+  OfflineRunner(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
                 ParticleFilterTopologyStage* topology = nullptr);
 
   /// Starts the next traversal (a fresh segmentation window); the first one starts implicitly. An open
