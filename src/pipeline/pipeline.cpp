@@ -6,6 +6,7 @@
 #include <cmath>
 #include <deque>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -60,8 +61,18 @@ std::string PipelineConfig::validate() const {
     return rangeError("status_period_s", status_period_s, "0.1 .. 60 (seconds)");
   if (thumbnail_width < 16 || thumbnail_width > 1280)
     return rangeError("thumbnail_width", thumbnail_width, "16 .. 1280 (pixels)");
-  if (!(map_save_period_s == 0.0 || (map_save_period_s >= 1.0 && map_save_period_s <= 86400.0)))
-    return rangeError("map_save_period_s", map_save_period_s, "0 (only at stop) or 1 .. 86400 (seconds)");
+  return "";
+}
+
+std::string MapConfig::validate() const {
+  if (path.size() > 4096) return "path: longer than 4096 characters";
+  if (!(save_period_s == 0.0 || (save_period_s >= 1.0 && save_period_s <= 86400.0)))
+    return rangeError("save_period_s", save_period_s, "0 (only at stop) or 1 .. 86400 (seconds)");
+  if (!(max_mb >= 1.0 && max_mb <= 65536.0)) return rangeError("max_mb", max_mb, "1 .. 65536 (MB)");
+  return "";
+}
+
+std::string WatchdogConfig::validate() const {
   if (!(heartbeat_timeout_s >= 0.5 && heartbeat_timeout_s <= 600.0))
     return rangeError("heartbeat_timeout_s", heartbeat_timeout_s, "0.5 .. 600 (seconds)");
   return "";
@@ -132,17 +143,22 @@ bool carriesPlace(const FrameResult& r) {
 
 }  // namespace
 
-Pipeline::Pipeline(const PipelineConfig& config, FrameSource& source, FingerprintStage& fingerprint,
-                   SegmentationStage& segmentation, TopologyStage& topology, PipelineSink& sink, const Clock& clock)
+Pipeline::Pipeline(const PipelineConfig& config, const MapConfig& map, const WatchdogConfig& watchdog,
+                   FrameSource& source, FingerprintStage& fingerprint, SegmentationStage& segmentation,
+                   TopologyStage& topology, PipelineSink& sink, const Clock& clock)
     : config_(config),
+      map_(map),
+      watchdog_(watchdog),
       source_(source),
       fingerprint_(fingerprint),
       segmentation_(segmentation),
       topology_(topology),
       sink_(sink),
       clock_(clock) {
-  if (std::string problem = config_.validate(); !problem.empty())
-    throw std::invalid_argument("pipeline." + problem);
+  const std::pair<const char*, std::string> sections[] = {
+      {"pipeline.", config_.validate()}, {"map.", map_.validate()}, {"watchdog.", watchdog_.validate()}};
+  for (const auto& [section, problem] : sections)
+    if (!problem.empty()) throw std::invalid_argument(section + problem);
   config_.queues.overflow = resolveOverflow(config_.queues.overflow, source_.realTime());
   frames_ = std::make_unique<BoundedQueue<CapturedFrame>>(static_cast<std::size_t>(config_.queues.frames));
   fingerprints_ = std::make_unique<BoundedQueue<Fingerprinted>>(static_cast<std::size_t>(config_.queues.fingerprints));
@@ -189,7 +205,7 @@ void Pipeline::wait() { threads_.joinAll(); }
 double Pipeline::failingWithoutProgressFor(double now) const {
   const double failed = last_frame_failed_s_.load();
   const double passed = last_frame_fingerprinted_s_.load();
-  const double timeout = config_.heartbeat_timeout_s;
+  const double timeout = watchdog_.heartbeat_timeout_s;
   // Failing recently (not a camera that sent one bad frame and then went silent: silence is healthy).
   if (failed > passed && now - failed <= timeout && now - passed > timeout) return now - passed;
   return 0.0;
@@ -198,7 +214,7 @@ double Pipeline::failingWithoutProgressFor(double now) const {
 bool Pipeline::healthy() const {
   const double now = clock_.now();
   for (int i = 0; i < kThreadCount; ++i)
-    if (!thread_done_[i].load() && !waiting_[i].load() && now - heartbeat_[i].load() > config_.heartbeat_timeout_s)
+    if (!thread_done_[i].load() && !waiting_[i].load() && now - heartbeat_[i].load() > watchdog_.heartbeat_timeout_s)
       return false;
   if (!thread_done_[kFingerprint].load() && failingWithoutProgressFor(now) > 0.0) return false;
   return error().empty();
@@ -210,7 +226,7 @@ std::string Pipeline::stalledStages() const {
   std::string out;
   for (int i = 0; i < kThreadCount; ++i) {
     const double silent = now - heartbeat_[i].load();
-    if (thread_done_[i].load() || waiting_[i].load() || silent <= config_.heartbeat_timeout_s) continue;
+    if (thread_done_[i].load() || waiting_[i].load() || silent <= watchdog_.heartbeat_timeout_s) continue;
     char item[64];
     std::snprintf(item, sizeof item, "%s%s %.1f s", out.empty() ? "" : ", ", kNames[i], silent);
     out += item;
@@ -369,7 +385,7 @@ void Pipeline::segmentationLoop() {
 }
 
 void Pipeline::saveMap(bool final) {
-  if (config_.map_path.empty()) return;
+  if (map_.path.empty()) return;
   const double t0 = clock_.now();
   MapWrite job{topology_.snapshotMap(), final, 0.0};
   job.snapshot_ms = (clock_.now() - t0) * 1e3;
@@ -386,16 +402,16 @@ void Pipeline::mapWriterLoop() {
   while (std::optional<MapWrite> job = map_writes_->pop()) {
     const double t0 = clock_.now();
     try {
-      job->snapshot->writeTo(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
+      job->snapshot->writeTo(map_.path);  // atomic by contract (MapStore: temporary file, fsync, rename)
       maps_saved_.fetch_add(1);
       spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, encode and write {:.2f} ms "
                    "in the map writer)",
-                   config_.map_path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
+                   map_.path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
     } catch (const std::exception& e) {
       if (job->final)
-        recordError("saving the map to " + config_.map_path + " failed: " + e.what());
+        recordError("saving the map to " + map_.path + " failed: " + e.what());
       else
-        spdlog::warn("pipeline: periodic map save to {} failed: {}", config_.map_path, e.what());
+        spdlog::warn("pipeline: periodic map save to {} failed: {}", map_.path, e.what());
     }
   }
   map_writer_done_.set_value();
@@ -405,7 +421,7 @@ void Pipeline::mapWriterLoop() {
 void Pipeline::topologyLoop() {
   std::deque<ClosedPlace> pending;  // places whose step is queued or in progress, oldest first
   std::int64_t published_revision = -1;
-  double next_save_s = clock_.now() + (config_.map_save_period_s > 0 ? config_.map_save_period_s : 0.0);
+  double next_save_s = clock_.now() + (map_.save_period_s > 0 ? map_.save_period_s : 0.0);
   const double budget_s = config_.filter_budget_ms * 1e-3;
 
   auto attach = [&](FrameResult& r, const PlaceAssignment& assignment) {
@@ -455,13 +471,13 @@ void Pipeline::topologyLoop() {
         if (!forward(*results_, std::move(r))) break;
         processed_[kTopology].fetch_add(1);
       }
-      if (config_.map_save_period_s > 0 && clock_.now() >= next_save_s && topology_.idle()) {
+      if (map_.save_period_s > 0 && clock_.now() >= next_save_s && topology_.idle()) {
         try {
           saveMap(false);
         } catch (const std::exception& e) {
-          spdlog::warn("pipeline: periodic map snapshot for {} failed: {}", config_.map_path, e.what());
+          spdlog::warn("pipeline: periodic map snapshot for {} failed: {}", map_.path, e.what());
         }
-        next_save_s = clock_.now() + config_.map_save_period_s;
+        next_save_s = clock_.now() + map_.save_period_s;
       }
     }
     // End of stream or stop: finish the steps in progress, publish them on a flush record, save.
@@ -479,7 +495,7 @@ void Pipeline::topologyLoop() {
     try {
       saveMap(true);
     } catch (const std::exception& e) {
-      recordError("saving the map to " + config_.map_path + " failed: " + e.what());
+      recordError("saving the map to " + map_.path + " failed: " + e.what());
     }
   }
   map_writes_->close();
