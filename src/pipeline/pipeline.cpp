@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 
@@ -93,28 +94,6 @@ std::string statusLine(const PipelineStatus& s) {
                 s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
                 static_cast<long long>(s.frames_dropped), static_cast<long long>(s.queue_kept_waits), camera);
   return text;
-}
-
-LatencyStats summarizeLatencies(std::vector<double>& values_ms) {
-  LatencyStats stats;
-  stats.samples = static_cast<std::int64_t>(values_ms.size());
-  if (values_ms.empty()) return stats;
-  const std::size_t n = values_ms.size();
-  auto at_rank = [&](std::size_t rank) {  // rank-th smallest, from 0
-    std::nth_element(values_ms.begin(), values_ms.begin() + static_cast<std::ptrdiff_t>(rank), values_ms.end());
-    return values_ms[rank];
-  };
-  const std::size_t p99_rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(n))) - 1;
-  stats.max_ms = *std::max_element(values_ms.begin(), values_ms.end());
-  stats.p99_ms = at_rank(p99_rank);
-  if (n % 2 == 1) {
-    stats.median_ms = at_rank(n / 2);
-  } else {
-    const double upper = at_rank(n / 2);
-    const double lower = *std::max_element(values_ms.begin(), values_ms.begin() + static_cast<std::ptrdiff_t>(n / 2));
-    stats.median_ms = 0.5 * (lower + upper);
-  }
-  return stats;
 }
 
 struct Pipeline::CapturedFrame {
@@ -506,64 +485,38 @@ void Pipeline::topologyLoop() {
   finished_threads_.fetch_add(1);
 }
 
-void Pipeline::publisherLoop() {
-  const std::size_t expected = 1024;
-  std::vector<double> window[kThreadCount + 1];  // per-stage work and end-to-end latency, this period
-  for (auto& w : window) w.reserve(expected);
-  double period_start = clock_.now();
-  double period_cpu_start = processCpuSeconds();
-  double stage_cpu_start[kThreadCount] = {};
-  std::int64_t published = 0, published_at_period_start = 0;
+StatusCounters Pipeline::statusCounters(std::int64_t published) const {
+  StatusCounters c;
+  const QueueCounters inputs[kThreadCount] = {QueueCounters{}, frames_->counters(), fingerprints_->counters(),
+                                              segmented_->counters(), results_->counters()};
+  c.stages.resize(kThreadCount);
+  for (int i = 0; i < kThreadCount; ++i) {
+    c.stages[static_cast<std::size_t>(i)].processed = i == kPublisher ? published : processed_[i].load();
+    c.stages[static_cast<std::size_t>(i)].input = inputs[i];
+    c.stages[static_cast<std::size_t>(i)].cpu_s = thread_cpu_s_[i].load();
+  }
+  c.process_cpu_s = processCpuSeconds();
+  c.frames_captured = processed_[kCapture].load();
+  c.source_skipped = source_skipped_.load();
+  c.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
+  c.source_reconnects = source_reconnects_.load();
+  c.source_reconnect_attempts = source_reconnect_attempts_.load();
+  c.source_dropped = source_dropped_.load();
+  c.places = places_.load();
+  c.map_revision = map_revision_.load();
+  c.maps_saved = maps_saved_.load();
+  return c;
+}
 
+void Pipeline::publisherLoop() {
+  StatusCollector collector(std::vector<std::string>(std::begin(kStageNames), std::end(kStageNames)), start_time_s_,
+                            clock_.now(), processCpuSeconds());
   auto emitStatus = [&](const char* state) {
     const double now = clock_.now();
-    const double elapsed = std::max(1e-9, now - period_start);
-    PipelineStatus s;
-    s.time_s = now;
-    s.uptime_s = now - start_time_s_;
-    s.fps = static_cast<double>(published - published_at_period_start) / elapsed;
-    s.frames_captured = processed_[kCapture].load();
-    s.frames_published = published;
-    s.source_skipped = source_skipped_.load();
-    s.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
-    s.source_reconnects = source_reconnects_.load();
-    s.source_reconnect_attempts = source_reconnect_attempts_.load();
-    s.source_dropped = source_dropped_.load();
-    s.latency = summarizeLatencies(window[kThreadCount]);
-    const QueueCounters inputs[kThreadCount] = {QueueCounters{}, frames_->counters(), fingerprints_->counters(),
-                                                segmented_->counters(), results_->counters()};
-    s.stages.reserve(kThreadCount);
-    for (int i = 0; i < kThreadCount; ++i) {
-      StageStatus st;
-      st.name = kStageNames[i];
-      st.latency = summarizeLatencies(window[i]);
-      st.processed = i == kPublisher ? published : processed_[i].load();
-      st.dropped = inputs[i].dropped;
-      st.kept_waits = inputs[i].kept_waits;
-      st.queue_depth = inputs[i].depth;
-      st.queue_capacity = inputs[i].capacity;
-      const double cpu = thread_cpu_s_[i].load();
-      st.cpu_percent = 100.0 * (cpu - stage_cpu_start[i]) / elapsed;
-      stage_cpu_start[i] = cpu;
-      s.frames_dropped += inputs[i].dropped;
-      s.queue_kept_waits += inputs[i].kept_waits;
-      s.stages.push_back(std::move(st));
-    }
-    const double process_cpu = processCpuSeconds();
-    s.cpu_percent = 100.0 * (process_cpu - period_cpu_start) / elapsed;
-    s.places = places_.load();
-    s.map_revision = map_revision_.load();
-    s.maps_saved = maps_saved_.load();
-    s.state = state;
+    PipelineStatus s = collector.collect(now, state, statusCounters(collector.published()));
     sink_.publishStatus(s);
-    {
-      std::lock_guard lock(status_mutex_);
-      status_ = std::move(s);
-    }
-    for (auto& w : window) w.clear();
-    period_start = now;
-    period_cpu_start = process_cpu;
-    published_at_period_start = published;
+    std::lock_guard lock(status_mutex_);
+    status_ = std::move(s);
   };
 
   try {
@@ -578,18 +531,17 @@ void Pipeline::publisherLoop() {
         sink_.publish(r);
         const double t1 = clock_.now();
         if (r.has_frame) {
-          ++published;
           const double latency_ms = (t1 - r.captured_at_s) * 1e3;
-          window[kFingerprint].push_back(r.fingerprint_ms);
-          window[kSegmentation].push_back(r.segmentation_ms);
-          window[kTopology].push_back(r.filter_ms);
-          window[kPublisher].push_back((t1 - t0) * 1e3);
-          window[kThreadCount].push_back(latency_ms);
+          collector.addStageMs(kFingerprint, r.fingerprint_ms);
+          collector.addStageMs(kSegmentation, r.segmentation_ms);
+          collector.addStageMs(kTopology, r.filter_ms);
+          collector.addStageMs(kPublisher, (t1 - t0) * 1e3);
+          collector.addPublished(latency_ms);
           if (config_.record_latencies) latencies_ms_.push_back(latency_ms);
         }
       }
       if (wait == QueueWait::Closed) break;
-      if (clock_.now() - period_start >= config_.status_period_s)
+      if (collector.due(clock_.now(), config_.status_period_s))
         emitStatus(stop_requested_.load() ? "stopping" : "running");
     }
     thread_done_[kPublisher].store(true);

@@ -38,6 +38,7 @@
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/pipeline/stages.hpp"
+#include "toposlam/pipeline/status_collector.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 
 namespace toposlam {
@@ -113,8 +114,6 @@ struct WatchdogConfig {
 /// part reads "camera reconnecting (attempt N, ...)".
 std::string statusLine(const PipelineStatus& status);
 
-/// Median, p99 (nearest rank) and max of `values_ms`; all zero when empty. Reorders `values_ms`.
-LatencyStats summarizeLatencies(std::vector<double>& values_ms);
 
 class Pipeline {
  public:
@@ -168,6 +167,8 @@ class Pipeline {
   void segmentationLoop();
   void topologyLoop();
   void publisherLoop();
+  /// The counters a status reads (publisher thread); `published`: the publisher's own count.
+  StatusCounters statusCounters(std::int64_t published) const;
   void mapWriterLoop();
   /// Snapshot now (topology thread, when idle) and hand it to the map writer; `final` at stop.
   void saveMap(bool final);
