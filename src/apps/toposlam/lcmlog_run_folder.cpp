@@ -91,7 +91,8 @@ void writeRunFolderFromLog(const LoggedRun& run, const std::string& log_path, co
     topology.particles = run.topology->particles;
     for (const TopologyNode& t : run.topology->nodes)
       topology.nodes.push_back(TopologyFile::Node{t.id, t.places, t.representative_frames, {}});
-    for (const TopologyEdge& e : run.topology->edges) topology.edges.push_back(TopologyFile::Edge{e.from, e.to, e.count});
+    for (const TopologyEdge& e : run.topology->edges)
+      topology.edges.push_back(TopologyFile::Edge{e.from, e.to, e.count});
   }
   for (const LoggedPlace& p : run.places) {
     TopologyFile::Step& step = topology.history.emplace_back();
@@ -110,9 +111,9 @@ void writeRunFolderFromLog(const LoggedRun& run, const std::string& log_path, co
     out.commit();
   }
   writeSettings(dir, {{"source", "lcmlog:" + fs::absolute(log_path).string()},
-                                          {"log events", std::to_string(run.events)},
-                                          {"place estimates", std::to_string(run.frames.size())},
-                                          {"place events", std::to_string(run.places.size())}});
+                      {"log events", std::to_string(run.events)},
+                      {"place estimates", std::to_string(run.frames.size())},
+                      {"place events", std::to_string(run.places.size())}});
 }
 
 }  // namespace toposlam::cli
