@@ -207,7 +207,7 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(integer("record.queue_frames", AT(record.queue_frames), 16, 1, 1024, "frames",
                       "frames waiting for the writer before the oldest is dropped (counted)"));
   // Map.
-  k.push_back(text("map.path", AT(pipeline.map_path), "map.tsm", 0, 4096,
+  k.push_back(text("map.path", AT(map.path), "map.tsm", 0, 4096,
                    "the map file (MapStore format, docs/topology.md). Relative paths resolve against "
                    "$STATE_DIRECTORY (systemd StateDirectory=toposlam: /var/lib/toposlam), else the working "
                    "directory. \"\" = never saved")
@@ -225,12 +225,12 @@ std::vector<ConfigKey> makeKeys() {
                    "the same folder continues after that frame (each frame is mapped once); true reads the "
                    "folder from its first frame again")
                   .withOption("--source-from-start", true));
-  k.push_back(real("map.save_period_s", AT(pipeline.map_save_period_s), 60.0, 0, 86400, "seconds",
+  k.push_back(real("map.save_period_s", AT(map.save_period_s), 60.0, 0, 86400, "seconds",
                    "seconds between periodic saves")
                   .withNote("0 = only at stop, else at least 1")
                   .withOption("--save-period")
                   .withCrossCheck([](const DaemonConfig& c) -> std::string {
-                    const double v = c.pipeline.map_save_period_s;
+                    const double v = c.map.save_period_s;
                     if (v == 0.0 || v >= 1.0) return "";
                     return rangeNumber(v) + " is out of range, allowed 0 (only at stop) or [1, 86400] seconds";
                   }));
@@ -239,7 +239,7 @@ std::vector<ConfigKey> makeKeys() {
   // Watchdog.
   k.push_back(flag("watchdog.enabled", AT(watchdog.enabled), true,
                    "ping systemd (WatchdogSec= in the unit) while the pipeline is healthy"));
-  k.push_back(real("watchdog.heartbeat_timeout_s", AT(pipeline.heartbeat_timeout_s), 5.0, 0.5, 600, "seconds",
+  k.push_back(real("watchdog.heartbeat_timeout_s", AT(watchdog.heartbeat_timeout_s), 5.0, 0.5, 600, "seconds",
                    "a stage thread silent this long stops the pings"));
   // Pipeline.
   k.push_back(integer("pipeline.queues.frames", AT(pipeline.queues.frames), 2, 1, 1024, "frames",

@@ -195,7 +195,7 @@ void applyMethodPreset(const std::string& name, DaemonConfig& c) {
 }
 
 DaemonConfig::DaemonConfig() {
-  pipeline.map_path = "map.tsm";
+  map.path = "map.tsm";
   applyMethodPreset(preset, *this);
 }
 
@@ -210,6 +210,8 @@ std::string DaemonConfig::validate() const {
   // problem found only here is reported as the stage words it.
   const std::pair<const char*, std::string> stages[] = {
       {"pipeline (PipelineConfig)", pipeline.validate()},
+      {"map (MapConfig)", map.validate()},
+      {"watchdog (WatchdogConfig)", watchdog.validate()},
       {"fingerprint (VpackConfig)", fingerprint.validate()},
       {"similarity (NgramSimilarityConfig)", similarity.validate()},
       {"segmentation (FiedlerSegmenterConfig)", segmentation.validate()},

@@ -19,65 +19,6 @@ namespace toposlam::eval {
 
 namespace fs = std::filesystem;
 
-RunData loadRun(const std::string& dir) {
-  if (!fs::is_directory(dir)) throw RunFileError(dir + ": not a run folder (no such directory)");
-  RunData run;
-  run.dir = dir;
-  const fs::path root(dir);
-  if (!fs::exists(root / "frames.csv")) {
-    throw RunFileError((root / "frames.csv").string() +
-                       ": missing; give a folder written by `toposlam segment` or `toposlam map`");
-  }
-  run.frames = loadFrames((root / "frames.csv").string());
-  {
-    std::ifstream header((root / "frames.csv").string());
-    std::string line;
-    std::getline(header, line);
-    run.has_frame_matches = (',' + line + ',').find(",match,") != std::string::npos;
-  }
-  const auto frame_count = static_cast<std::int64_t>(run.frames.size());
-  // Places must lie inside frames.csv (loadPlaces already checked 0 <= first <= representative <= last).
-  auto loadPlacesWithin = [&](const std::string& name) {
-    const std::string path = (root / name).string();
-    std::vector<PlaceRecord> places = loadPlaces(path);
-    for (const PlaceRecord& p : places) {
-      if (p.last >= frame_count) {
-        throw RunFileError(path + ":" + std::to_string(p.line) + ": place " + std::to_string(p.place) +
-                           " spans frames " + std::to_string(p.first) + ".." + std::to_string(p.last) +
-                           " but frames.csv has " + std::to_string(frame_count) +
-                           " frames (a damaged or mixed-up run folder)");
-      }
-    }
-    return places;
-  };
-  if (fs::exists(root / "places.csv")) run.places = loadPlacesWithin("places.csv");
-  if (fs::exists(root / "dropped_places.csv")) run.dropped_places = loadPlacesWithin("dropped_places.csv");
-  if (fs::exists(root / "topology.json")) run.topology = loadTopology((root / "topology.json").string());
-  if (fs::exists(root / "timing.csv")) run.timing = loadTiming((root / "timing.csv").string());
-  if (std::ifstream sources(root / "source.txt"); sources) {
-    for (std::string line; std::getline(sources, line);)
-      if (!line.empty()) run.sources.push_back(line);
-  }
-  if (std::ifstream settings(root / "settings.txt"); settings) {
-    int number = 0;
-    for (std::string line; std::getline(settings, line);) {
-      ++number;
-      if (line.empty() || line[0] == '#') continue;
-      const auto eq = line.find(" = ");
-      if (eq == std::string::npos)
-        throw RunFileError((root / "settings.txt").string() + ":" + std::to_string(number) +
-                           ": expected 'key = value', got '" + line + "'");
-      run.settings.emplace_back(line.substr(0, eq), line.substr(eq + 3));
-    }
-  }
-  run.traversal_starts.push_back(0);
-  for (std::size_t f = 1; f < run.frames.size(); ++f) {
-    if (run.frames[f].time_s < run.frames[f - 1].time_s)
-      run.traversal_starts.push_back(static_cast<std::int64_t>(f));
-  }
-  return run;
-}
-
 std::vector<std::int64_t> splitTraversals(std::int64_t frame_count, int count) {
   std::vector<std::int64_t> starts;
   for (int t = 0; t < std::max(1, count); ++t) starts.push_back(frame_count * t / std::max(1, count));
@@ -361,7 +302,7 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
   }
   if (run.topology) {
     for (const auto& s : run.topology->history)
-      result.best_topology_probability.push_back(s.best_topology_probability);
+      result.best_topology_probability.push_back(s.best_topology_probability.value_or(0.0));
   }
   return result;
 }

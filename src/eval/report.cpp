@@ -132,7 +132,7 @@ SvgPlot probabilityPlot(const RunData& run) {
   if (run.topology) {
     for (const auto& s : run.topology->history) {
       best.x.push_back(s.place);
-      best.y.push_back(s.best_topology_probability);
+      best.y.push_back(s.best_topology_probability.value_or(0.0));
       node.x.push_back(s.place);
       node.y.push_back(s.probability);
     }
@@ -155,13 +155,13 @@ SvgPlot timingPlot(const RunData& run) {
   for (const auto& t : run.timing) {
     const double x = static_cast<double>(t.frame);
     total.x.push_back(x);
-    total.y.push_back(t.fingerprint_ms + t.segment_ms + t.filter_ms);
+    total.y.push_back(t.fingerprint_ms + t.segment_ms + t.filter_ms.value_or(0.0));
     fp.x.push_back(x);
     fp.y.push_back(t.fingerprint_ms);
     seg.x.push_back(x);
     seg.y.push_back(t.segment_ms);
     filt.x.push_back(x);
-    filt.y.push_back(t.filter_ms);
+    filt.y.push_back(t.filter_ms.value_or(0.0));
   }
   plot.series = {total, fp, seg, filt};
   return plot;
@@ -265,9 +265,9 @@ std::string topologyMarkup(const RunData& run, const std::vector<std::string>& t
     return "<p class=\"note\">No topology.json in this run folder.</p>\n";
   const TopologyFile& topo = *run.topology;
   // Order nodes by their first place (the order the robot discovered them).
-  std::vector<const TopologyNode*> nodes;
+  std::vector<const TopologyFile::Node*> nodes;
   for (const auto& node : topo.nodes) nodes.push_back(&node);
-  auto first_place = [](const TopologyNode* node) {
+  auto first_place = [](const TopologyFile::Node* node) {
     return node->places.empty() ? 1 << 30 : *std::min_element(node->places.begin(), node->places.end());
   };
   std::stable_sort(nodes.begin(), nodes.end(),
@@ -320,7 +320,7 @@ std::string topologyMarkup(const RunData& run, const std::vector<std::string>& t
     html << "\n";
   }
   if (!svg_only) html << "</svg>\n";
-  for (const TopologyNode* node : nodes) {
+  for (const TopologyFile::Node* node : nodes) {
     const auto [x, y] = position[node->id];
     std::string thumb;
     for (std::int64_t f : node->representative_frames) {
@@ -578,10 +578,10 @@ std::string renderReportHtml(const ReportInputs& in) {
     html << "<h2>Processing time per frame (thesis Figures 5.6/5.7)</h2>\n";
     std::vector<double> t_total, t_fp, t_seg, t_filt;
     for (const auto& t : run.timing) {
-      t_total.push_back(t.fingerprint_ms + t.segment_ms + t.filter_ms);
+      t_total.push_back(t.fingerprint_ms + t.segment_ms + t.filter_ms.value_or(0.0));
       t_fp.push_back(t.fingerprint_ms);
       t_seg.push_back(t.segment_ms);
-      t_filt.push_back(t.filter_ms);
+      t_filt.push_back(t.filter_ms.value_or(0.0));
     }
     html << "<div>" << inlineSvg(timingPlot(run)) << "</div>\n";
     html << "<table class=\"eval\"><caption>Time per frame, "

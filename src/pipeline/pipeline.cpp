@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <iterator>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -60,8 +62,18 @@ std::string PipelineConfig::validate() const {
     return rangeError("status_period_s", status_period_s, "0.1 .. 60 (seconds)");
   if (thumbnail_width < 16 || thumbnail_width > 1280)
     return rangeError("thumbnail_width", thumbnail_width, "16 .. 1280 (pixels)");
-  if (!(map_save_period_s == 0.0 || (map_save_period_s >= 1.0 && map_save_period_s <= 86400.0)))
-    return rangeError("map_save_period_s", map_save_period_s, "0 (only at stop) or 1 .. 86400 (seconds)");
+  return "";
+}
+
+std::string MapConfig::validate() const {
+  if (path.size() > 4096) return "path: longer than 4096 characters";
+  if (!(save_period_s == 0.0 || (save_period_s >= 1.0 && save_period_s <= 86400.0)))
+    return rangeError("save_period_s", save_period_s, "0 (only at stop) or 1 .. 86400 (seconds)");
+  if (!(max_mb >= 1.0 && max_mb <= 65536.0)) return rangeError("max_mb", max_mb, "1 .. 65536 (MB)");
+  return "";
+}
+
+std::string WatchdogConfig::validate() const {
   if (!(heartbeat_timeout_s >= 0.5 && heartbeat_timeout_s <= 600.0))
     return rangeError("heartbeat_timeout_s", heartbeat_timeout_s, "0.5 .. 600 (seconds)");
   return "";
@@ -82,28 +94,6 @@ std::string statusLine(const PipelineStatus& s) {
                 s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
                 static_cast<long long>(s.frames_dropped), static_cast<long long>(s.queue_kept_waits), camera);
   return text;
-}
-
-LatencyStats summarizeLatencies(std::vector<double>& values_ms) {
-  LatencyStats stats;
-  stats.samples = static_cast<std::int64_t>(values_ms.size());
-  if (values_ms.empty()) return stats;
-  const std::size_t n = values_ms.size();
-  auto at_rank = [&](std::size_t rank) {  // rank-th smallest, from 0
-    std::nth_element(values_ms.begin(), values_ms.begin() + static_cast<std::ptrdiff_t>(rank), values_ms.end());
-    return values_ms[rank];
-  };
-  const std::size_t p99_rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(n))) - 1;
-  stats.max_ms = *std::max_element(values_ms.begin(), values_ms.end());
-  stats.p99_ms = at_rank(p99_rank);
-  if (n % 2 == 1) {
-    stats.median_ms = at_rank(n / 2);
-  } else {
-    const double upper = at_rank(n / 2);
-    const double lower = *std::max_element(values_ms.begin(), values_ms.begin() + static_cast<std::ptrdiff_t>(n / 2));
-    stats.median_ms = 0.5 * (lower + upper);
-  }
-  return stats;
 }
 
 struct Pipeline::CapturedFrame {
@@ -132,17 +122,22 @@ bool carriesPlace(const FrameResult& r) {
 
 }  // namespace
 
-Pipeline::Pipeline(const PipelineConfig& config, FrameSource& source, FingerprintStage& fingerprint,
-                   SegmentationStage& segmentation, TopologyStage& topology, PipelineSink& sink, const Clock& clock)
+Pipeline::Pipeline(const PipelineConfig& config, const MapConfig& map, const WatchdogConfig& watchdog,
+                   FrameSource& source, FingerprintStage& fingerprint, SegmentationStage& segmentation,
+                   TopologyStage& topology, PipelineSink& sink, const Clock& clock)
     : config_(config),
+      map_(map),
+      watchdog_(watchdog),
       source_(source),
       fingerprint_(fingerprint),
       segmentation_(segmentation),
       topology_(topology),
       sink_(sink),
       clock_(clock) {
-  if (std::string problem = config_.validate(); !problem.empty())
-    throw std::invalid_argument("pipeline." + problem);
+  const std::pair<const char*, std::string> sections[] = {
+      {"pipeline.", config_.validate()}, {"map.", map_.validate()}, {"watchdog.", watchdog_.validate()}};
+  for (const auto& [section, problem] : sections)
+    if (!problem.empty()) throw std::invalid_argument(section + problem);
   config_.queues.overflow = resolveOverflow(config_.queues.overflow, source_.realTime());
   frames_ = std::make_unique<BoundedQueue<CapturedFrame>>(static_cast<std::size_t>(config_.queues.frames));
   fingerprints_ = std::make_unique<BoundedQueue<Fingerprinted>>(static_cast<std::size_t>(config_.queues.fingerprints));
@@ -189,7 +184,7 @@ void Pipeline::wait() { threads_.joinAll(); }
 double Pipeline::failingWithoutProgressFor(double now) const {
   const double failed = last_frame_failed_s_.load();
   const double passed = last_frame_fingerprinted_s_.load();
-  const double timeout = config_.heartbeat_timeout_s;
+  const double timeout = watchdog_.heartbeat_timeout_s;
   // Failing recently (not a camera that sent one bad frame and then went silent: silence is healthy).
   if (failed > passed && now - failed <= timeout && now - passed > timeout) return now - passed;
   return 0.0;
@@ -198,7 +193,7 @@ double Pipeline::failingWithoutProgressFor(double now) const {
 bool Pipeline::healthy() const {
   const double now = clock_.now();
   for (int i = 0; i < kThreadCount; ++i)
-    if (!thread_done_[i].load() && !waiting_[i].load() && now - heartbeat_[i].load() > config_.heartbeat_timeout_s)
+    if (!thread_done_[i].load() && !waiting_[i].load() && now - heartbeat_[i].load() > watchdog_.heartbeat_timeout_s)
       return false;
   if (!thread_done_[kFingerprint].load() && failingWithoutProgressFor(now) > 0.0) return false;
   return error().empty();
@@ -210,7 +205,7 @@ std::string Pipeline::stalledStages() const {
   std::string out;
   for (int i = 0; i < kThreadCount; ++i) {
     const double silent = now - heartbeat_[i].load();
-    if (thread_done_[i].load() || waiting_[i].load() || silent <= config_.heartbeat_timeout_s) continue;
+    if (thread_done_[i].load() || waiting_[i].load() || silent <= watchdog_.heartbeat_timeout_s) continue;
     char item[64];
     std::snprintf(item, sizeof item, "%s%s %.1f s", out.empty() ? "" : ", ", kNames[i], silent);
     out += item;
@@ -369,7 +364,7 @@ void Pipeline::segmentationLoop() {
 }
 
 void Pipeline::saveMap(bool final) {
-  if (config_.map_path.empty()) return;
+  if (map_.path.empty()) return;
   const double t0 = clock_.now();
   MapWrite job{topology_.snapshotMap(), final, 0.0};
   job.snapshot_ms = (clock_.now() - t0) * 1e3;
@@ -386,16 +381,16 @@ void Pipeline::mapWriterLoop() {
   while (std::optional<MapWrite> job = map_writes_->pop()) {
     const double t0 = clock_.now();
     try {
-      job->snapshot->writeTo(config_.map_path);  // atomic by contract (MapStore: temporary file, fsync, rename)
+      job->snapshot->writeTo(map_.path);  // atomic by contract (MapStore: temporary file, fsync, rename)
       maps_saved_.fetch_add(1);
       spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, encode and write {:.2f} ms "
                    "in the map writer)",
-                   config_.map_path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
+                   map_.path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
     } catch (const std::exception& e) {
       if (job->final)
-        recordError("saving the map to " + config_.map_path + " failed: " + e.what());
+        recordError("saving the map to " + map_.path + " failed: " + e.what());
       else
-        spdlog::warn("pipeline: periodic map save to {} failed: {}", config_.map_path, e.what());
+        spdlog::warn("pipeline: periodic map save to {} failed: {}", map_.path, e.what());
     }
   }
   map_writer_done_.set_value();
@@ -405,7 +400,7 @@ void Pipeline::mapWriterLoop() {
 void Pipeline::topologyLoop() {
   std::deque<ClosedPlace> pending;  // places whose step is queued or in progress, oldest first
   std::int64_t published_revision = -1;
-  double next_save_s = clock_.now() + (config_.map_save_period_s > 0 ? config_.map_save_period_s : 0.0);
+  double next_save_s = clock_.now() + (map_.save_period_s > 0 ? map_.save_period_s : 0.0);
   const double budget_s = config_.filter_budget_ms * 1e-3;
 
   auto attach = [&](FrameResult& r, const PlaceAssignment& assignment) {
@@ -455,13 +450,13 @@ void Pipeline::topologyLoop() {
         if (!forward(*results_, std::move(r))) break;
         processed_[kTopology].fetch_add(1);
       }
-      if (config_.map_save_period_s > 0 && clock_.now() >= next_save_s && topology_.idle()) {
+      if (map_.save_period_s > 0 && clock_.now() >= next_save_s && topology_.idle()) {
         try {
           saveMap(false);
         } catch (const std::exception& e) {
-          spdlog::warn("pipeline: periodic map snapshot for {} failed: {}", config_.map_path, e.what());
+          spdlog::warn("pipeline: periodic map snapshot for {} failed: {}", map_.path, e.what());
         }
-        next_save_s = clock_.now() + config_.map_save_period_s;
+        next_save_s = clock_.now() + map_.save_period_s;
       }
     }
     // End of stream or stop: finish the steps in progress, publish them on a flush record, save.
@@ -479,7 +474,7 @@ void Pipeline::topologyLoop() {
     try {
       saveMap(true);
     } catch (const std::exception& e) {
-      recordError("saving the map to " + config_.map_path + " failed: " + e.what());
+      recordError("saving the map to " + map_.path + " failed: " + e.what());
     }
   }
   map_writes_->close();
@@ -490,64 +485,38 @@ void Pipeline::topologyLoop() {
   finished_threads_.fetch_add(1);
 }
 
-void Pipeline::publisherLoop() {
-  const std::size_t expected = 1024;
-  std::vector<double> window[kThreadCount + 1];  // per-stage work and end-to-end latency, this period
-  for (auto& w : window) w.reserve(expected);
-  double period_start = clock_.now();
-  double period_cpu_start = processCpuSeconds();
-  double stage_cpu_start[kThreadCount] = {};
-  std::int64_t published = 0, published_at_period_start = 0;
+StatusCounters Pipeline::statusCounters(std::int64_t published) const {
+  StatusCounters c;
+  const QueueCounters inputs[kThreadCount] = {QueueCounters{}, frames_->counters(), fingerprints_->counters(),
+                                              segmented_->counters(), results_->counters()};
+  c.stages.resize(kThreadCount);
+  for (int i = 0; i < kThreadCount; ++i) {
+    c.stages[static_cast<std::size_t>(i)].processed = i == kPublisher ? published : processed_[i].load();
+    c.stages[static_cast<std::size_t>(i)].input = inputs[i];
+    c.stages[static_cast<std::size_t>(i)].cpu_s = thread_cpu_s_[i].load();
+  }
+  c.process_cpu_s = processCpuSeconds();
+  c.frames_captured = processed_[kCapture].load();
+  c.source_skipped = source_skipped_.load();
+  c.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
+  c.source_reconnects = source_reconnects_.load();
+  c.source_reconnect_attempts = source_reconnect_attempts_.load();
+  c.source_dropped = source_dropped_.load();
+  c.places = places_.load();
+  c.map_revision = map_revision_.load();
+  c.maps_saved = maps_saved_.load();
+  return c;
+}
 
+void Pipeline::publisherLoop() {
+  StatusCollector collector(std::vector<std::string>(std::begin(kStageNames), std::end(kStageNames)), start_time_s_,
+                            clock_.now(), processCpuSeconds());
   auto emitStatus = [&](const char* state) {
     const double now = clock_.now();
-    const double elapsed = std::max(1e-9, now - period_start);
-    PipelineStatus s;
-    s.time_s = now;
-    s.uptime_s = now - start_time_s_;
-    s.fps = static_cast<double>(published - published_at_period_start) / elapsed;
-    s.frames_captured = processed_[kCapture].load();
-    s.frames_published = published;
-    s.source_skipped = source_skipped_.load();
-    s.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
-    s.source_reconnects = source_reconnects_.load();
-    s.source_reconnect_attempts = source_reconnect_attempts_.load();
-    s.source_dropped = source_dropped_.load();
-    s.latency = summarizeLatencies(window[kThreadCount]);
-    const QueueCounters inputs[kThreadCount] = {QueueCounters{}, frames_->counters(), fingerprints_->counters(),
-                                                segmented_->counters(), results_->counters()};
-    s.stages.reserve(kThreadCount);
-    for (int i = 0; i < kThreadCount; ++i) {
-      StageStatus st;
-      st.name = kStageNames[i];
-      st.latency = summarizeLatencies(window[i]);
-      st.processed = i == kPublisher ? published : processed_[i].load();
-      st.dropped = inputs[i].dropped;
-      st.kept_waits = inputs[i].kept_waits;
-      st.queue_depth = inputs[i].depth;
-      st.queue_capacity = inputs[i].capacity;
-      const double cpu = thread_cpu_s_[i].load();
-      st.cpu_percent = 100.0 * (cpu - stage_cpu_start[i]) / elapsed;
-      stage_cpu_start[i] = cpu;
-      s.frames_dropped += inputs[i].dropped;
-      s.queue_kept_waits += inputs[i].kept_waits;
-      s.stages.push_back(std::move(st));
-    }
-    const double process_cpu = processCpuSeconds();
-    s.cpu_percent = 100.0 * (process_cpu - period_cpu_start) / elapsed;
-    s.places = places_.load();
-    s.map_revision = map_revision_.load();
-    s.maps_saved = maps_saved_.load();
-    s.state = state;
+    PipelineStatus s = collector.collect(now, state, statusCounters(collector.published()));
     sink_.publishStatus(s);
-    {
-      std::lock_guard lock(status_mutex_);
-      status_ = std::move(s);
-    }
-    for (auto& w : window) w.clear();
-    period_start = now;
-    period_cpu_start = process_cpu;
-    published_at_period_start = published;
+    std::lock_guard lock(status_mutex_);
+    status_ = std::move(s);
   };
 
   try {
@@ -562,18 +531,17 @@ void Pipeline::publisherLoop() {
         sink_.publish(r);
         const double t1 = clock_.now();
         if (r.has_frame) {
-          ++published;
           const double latency_ms = (t1 - r.captured_at_s) * 1e3;
-          window[kFingerprint].push_back(r.fingerprint_ms);
-          window[kSegmentation].push_back(r.segmentation_ms);
-          window[kTopology].push_back(r.filter_ms);
-          window[kPublisher].push_back((t1 - t0) * 1e3);
-          window[kThreadCount].push_back(latency_ms);
+          collector.addStageMs(kFingerprint, r.fingerprint_ms);
+          collector.addStageMs(kSegmentation, r.segmentation_ms);
+          collector.addStageMs(kTopology, r.filter_ms);
+          collector.addStageMs(kPublisher, (t1 - t0) * 1e3);
+          collector.addPublished(latency_ms);
           if (config_.record_latencies) latencies_ms_.push_back(latency_ms);
         }
       }
       if (wait == QueueWait::Closed) break;
-      if (clock_.now() - period_start >= config_.status_period_s)
+      if (collector.due(clock_.now(), config_.status_period_s))
         emitStatus(stop_requested_.load() ? "stopping" : "running");
     }
     thread_done_[kPublisher].store(true);

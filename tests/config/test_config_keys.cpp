@@ -233,10 +233,10 @@ SCENARIO("GIVEN a command-line value WHEN set by its key's path THEN it is read 
   setConfigValue(c, "pipeline.queues.overflow", "block");
   setConfigValue(c, "map.load_at_start", "false");
   setConfigValue(c, "map.path", "");
-  CHECK(c.pipeline.map_save_period_s == 30.0);
+  CHECK(c.map.save_period_s == 30.0);
   CHECK(c.pipeline.queues.overflow == QueueOverflow::Block);
   CHECK_FALSE(c.map.load_at_start);
-  CHECK(c.pipeline.map_path.empty());
+  CHECK(c.map.path.empty());
   CHECK_THROWS_WITH(setConfigValue(c, "map.save_period_s", "soon"),
                     Catch::StartsWith("map.save_period_s: expected a number in [0, 86400] seconds"));
   CHECK_THROWS_WITH(setConfigValue(c, "topology.particles", "0"),

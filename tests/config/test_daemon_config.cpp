@@ -64,8 +64,8 @@ topology: {particles: 200, seed: 42}
   CHECK(c.lcm.url == "udpm://239.255.76.67:7667?ttl=1");
   CHECK(c.lcm.place_channel == "ROBOT1_PLACE");
   CHECK(c.lcm.status_channel == "TOPOSLAM_STATUS");
-  CHECK(c.pipeline.map_path == "/var/lib/toposlam/office.tsm");
-  CHECK(c.pipeline.map_save_period_s == 0.0);
+  CHECK(c.map.path == "/var/lib/toposlam/office.tsm");
+  CHECK(c.map.save_period_s == 0.0);
   CHECK_FALSE(c.map.load_at_start);
   CHECK(c.pipeline.queues.frames == 4);
   CHECK(c.pipeline.queues.overflow == QueueOverflow::Block);
@@ -187,10 +187,10 @@ SCENARIO("A folder, an endless file, a repeated key or a second document is refu
 SCENARIO("DaemonConfig::validate() names keys by their YAML path") {
   DaemonConfig c;
   CHECK(c.validate().empty());
-  c.pipeline.map_save_period_s = 0.5;
+  c.map.save_period_s = 0.5;
   CHECK_THAT(c.validate(), Catch::StartsWith("map.save_period_s: 0.5"));
   c = DaemonConfig{};
-  c.pipeline.heartbeat_timeout_s = 0;
+  c.watchdog.heartbeat_timeout_s = 0;
   CHECK_THAT(c.validate(), Catch::StartsWith("watchdog.heartbeat_timeout_s: "));
   c = DaemonConfig{};
   c.pipeline.queues.segmented = 0;

@@ -6,8 +6,9 @@
 
 #include "eval_fixture.hpp"
 #include "toposlam/eval/evaluation.hpp"
-#include "toposlam/eval/json_reader.hpp"
+#include "toposlam/run_folder/json_reader.hpp"
 
+using namespace toposlam;
 using namespace toposlam::eval;
 using namespace toposlam::eval::testing;
 using Catch::Matchers::Contains;

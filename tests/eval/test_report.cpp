@@ -5,6 +5,7 @@
 #include "eval_fixture.hpp"
 #include "toposlam/eval/report.hpp"
 
+using namespace toposlam;
 using namespace toposlam::eval;
 using namespace toposlam::eval::testing;
 using Catch::Matchers::Contains;

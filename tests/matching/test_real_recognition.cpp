@@ -15,7 +15,7 @@
 #include "camera_pixels.hpp"
 #include "toposlam/eval/orb_baseline.hpp"
 #include "toposlam/eval/recognition.hpp"
-#include "toposlam/eval/run_files.hpp"
+#include "toposlam/eval/ground_truth.hpp"
 #include "toposlam/io/file_sources.hpp"
 #include "toposlam/matching/labelled_image_list.hpp"
 #include "toposlam/matching/place_localizer.hpp"

@@ -1,6 +1,6 @@
 // Test fixture for the end-to-end mapping tests: a route's fingerprints (simulated worlds with room
 // labels, or the 84 real sample frames with their loop-closure matrix), computed once per process, and
-// the topology and segmentation scores of one OfflineMapper run over them (the daemon's stages) (src/eval's measures).
+// the topology and segmentation scores of one OfflineRunner run over them (the daemon's stages) (src/eval's measures).
 #pragma once
 
 #include <algorithm>
@@ -15,10 +15,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "toposlam/eval/metrics.hpp"
-#include "toposlam/eval/run_files.hpp"
+#include "toposlam/eval/ground_truth.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/clock.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace toposlam::testing {
@@ -113,19 +113,19 @@ inline MappingScore mapRoute(const MappingRoute& route, const FiedlerSegmenterCo
   filter_config.seed = seed;
   const ManualClock clock;
   ParticleFilterTopologyStage topology(filter_config, similarity, clock, TopologyStageConfig{});
-  OfflineMapper mapper(fingerprints, segmentation, &topology);
+  OfflineRunner runner(fingerprints, segmentation, &topology);
   for (std::size_t f = 0; f < route.fingerprints.size(); ++f) {
     const auto frame = static_cast<std::int64_t>(f);
     if (route.separate_sources && frame > 0 && std::count(route.traversal_starts.begin(), route.traversal_starts.end(), frame) > 0)
-      mapper.beginTraversal();
-    const SegmenterStep step = mapper.segment(route.times_s[f], "", route.fingerprints[f]);
-    if (step.closed_place) mapper.mapPlace(*step.closed_place);
+      runner.beginTraversal();
+    const SegmenterStep step = runner.segment(route.times_s[f], "", route.fingerprints[f]);
+    if (step.closed_place) runner.mapPlace(*step.closed_place);
   }
-  mapper.finish();
+  runner.finish();
 
   MappingScore score;
-  const SegmentationRun& run = mapper.run();
-  const std::vector<std::int64_t> nodes = mapper.placeNodes();
+  const SegmentationRun& run = runner.run();
+  const std::vector<std::int64_t> nodes = runner.placeNodes();
   score.kept = static_cast<int>(run.places.size());
   score.places = run.places;
   score.dropped = static_cast<int>(run.dropped_places.size());

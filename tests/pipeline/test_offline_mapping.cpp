@@ -1,5 +1,5 @@
 // End to end offline: simulator -> VPACK -> FiedlerSegmenter -> TopologyParticleFilter through the
-// OfflineMapper that `toposlam map` uses, scored with src/eval's topology measures. The two-traversal
+// OfflineRunner that `toposlam map` uses, scored with src/eval's topology measures. The two-traversal
 // office route must give the right topology: no node spans two rooms, no wrong loop closure, and the
 // second traversal lands on the first traversal's nodes.
 #include <catch2/catch.hpp>

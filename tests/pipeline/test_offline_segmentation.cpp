@@ -1,5 +1,5 @@
 // End to end on real frames: the 84 bundled sample frames (a corridor loop, ~1 Hz keyframes) through
-// VPACK (ORB) -> n-gram similarity -> FiedlerSegmenter, as `toposlam segment` runs them (OfflineMapper
+// VPACK (ORB) -> n-gram similarity -> FiedlerSegmenter, as `toposlam segment` runs them (OfflineRunner
 // driving the daemon's stages), and the run-folder writers.
 #include <catch2/catch.hpp>
 
@@ -13,7 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "toposlam/matching/ngram_similarity.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace {
@@ -44,7 +44,7 @@ TEST_CASE(
     REQUIRE(toposlam::FiedlerSegmenterConfig{}.window == 30);
     toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
     toposlam::FiedlerSegmentationStage segmentation_stage(toposlam::FiedlerSegmenterConfig{}, similarity, 1);
-    toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+    toposlam::OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
     for (std::size_t i = 0; i < frames.size(); ++i)
       pipeline.process(frames[i], static_cast<double>(i), std::to_string(i + 1) + ".jpg");
     pipeline.finish();
@@ -67,7 +67,7 @@ TEST_CASE(
     config.window = 5;
     toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
     toposlam::FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
-    toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+    toposlam::OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
     for (std::size_t i = 0; i < frames.size(); ++i) pipeline.process(frames[i], static_cast<double>(i));
     pipeline.finish();
     const toposlam::SegmentationRun& run = pipeline.run();
@@ -104,7 +104,7 @@ const SimRun& simulatedOfficeRun() {
     thesis.valley = {0.5, 0.25};
     toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
     toposlam::FiedlerSegmentationStage segmentation_stage(thesis, similarity, 1);
-    toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+    toposlam::OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
     SimRun result;
     while (auto frame = simulator.next()) {
       pipeline.process(frame->image, frame->truth.time_s);

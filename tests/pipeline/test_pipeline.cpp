@@ -26,11 +26,21 @@ PipelineConfig losslessConfig() {
   PipelineConfig c;
   c.queues.overflow = QueueOverflow::Block;
   c.filter_budget_ms = 2.0;
-  c.map_path = "/tmp/unused-by-fake.tsm";
-  c.map_save_period_s = 0.0;  // only at stop
   c.status_period_s = 60.0;
-  c.heartbeat_timeout_s = 600.0;
   return c;
+}
+
+MapConfig savedAtStop() {
+  MapConfig map;
+  map.path = "/tmp/unused-by-fake.tsm";
+  map.save_period_s = 0.0;  // only at stop
+  return map;
+}
+
+WatchdogConfig patientWatchdog(double heartbeat_timeout_s = 600.0) {
+  WatchdogConfig watchdog;
+  watchdog.heartbeat_timeout_s = heartbeat_timeout_s;
+  return watchdog;
 }
 
 }  // namespace
@@ -44,7 +54,8 @@ SCENARIO("The filter step of a place is spread over the following frames within 
     FakeTopology topology(clock, 5, 1e-3);
     RecordingSink sink;
     {
-      Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+      Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                        topology, sink, clock);
       pipeline.start();
       pipeline.wait();
       REQUIRE(pipeline.error().empty());
@@ -131,7 +142,8 @@ SCENARIO("A slow stage causes counted drops of the oldest frames, not growth") {
     PipelineConfig config = losslessConfig();
     config.queues.overflow = QueueOverflow::DropOldest;
     config.queues.frames = 2;
-    Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+    Pipeline pipeline(config, savedAtStop(), patientWatchdog(), source, fingerprint, segmentation, topology,
+                      sink, clock);
     pipeline.start();
     pipeline.wait();
     THEN("197 frames were dropped from the fingerprint stage's input and the newest two survived") {
@@ -163,7 +175,8 @@ SCENARIO("queues.overflow auto waits for a source that waits, and drops for one 
     PipelineConfig config = losslessConfig();
     config.queues.overflow = QueueOverflow::Auto;
     config.queues.frames = 2;
-    Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+    Pipeline pipeline(config, savedAtStop(), patientWatchdog(), source, fingerprint, segmentation, topology,
+                      sink, clock);
     pipeline.start();
     pipeline.wait();
     THEN("the queues block: every frame is published, none dropped") {
@@ -185,9 +198,11 @@ SCENARIO("queues.overflow auto waits for a source that waits, and drops for one 
     RecordingSink sink;
     PipelineConfig config = losslessConfig();
     config.queues.overflow = QueueOverflow::Auto;
-    const Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+    const Pipeline pipeline(config, savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                            topology, sink, clock);
     config.queues.overflow = QueueOverflow::Block;
-    const Pipeline told_to_block(config, source, fingerprint, segmentation, topology, sink, clock);
+    const Pipeline told_to_block(config, savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                                 topology, sink, clock);
     THEN("auto drops the oldest; a configured block stays block") {
       CHECK(pipeline.overflow() == QueueOverflow::DropOldest);
       CHECK(told_to_block.overflow() == QueueOverflow::Block);
@@ -205,7 +220,8 @@ SCENARIO("requestStop() finishes the filter steps in progress and saves the map 
     FakeSegmentation segmentation(10);
     FakeTopology topology(clock, 50, 1e-3);
     RecordingSink sink;
-    Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+    Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                      topology, sink, clock);
     pipeline.start();
     WHEN("stop is requested after 40 frames were published") {
       sink.waitForFrames(40);
@@ -236,7 +252,8 @@ SCENARIO("GIVEN a stream that ends inside a place WHEN it ends THEN that last pl
     FakeTopology topology(clock, 5, 1e-3);
     RecordingSink sink;
     {
-      Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+      Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                        topology, sink, clock);
       pipeline.start();
       pipeline.wait();
       REQUIRE(pipeline.error().empty());
@@ -268,7 +285,8 @@ SCENARIO("A failing stage ends the pipeline with an error instead of hanging") {
     segmentation.throw_at = 20;
     FakeTopology topology(clock, 1, 1e-3);
     RecordingSink sink;
-    Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+    Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                      topology, sink, clock);
     pipeline.start();
     pipeline.wait();
     THEN("every thread ended and the error names the stage") {
@@ -288,7 +306,8 @@ SCENARIO("Bad frames are skipped and counted, the stream goes on") {
     FakeSegmentation segmentation(1000);
     FakeTopology topology(clock, 1, 1e-3);
     RecordingSink sink;
-    Pipeline pipeline(losslessConfig(), source, fingerprint, segmentation, topology, sink, clock);
+    Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                      topology, sink, clock);
     pipeline.start();
     pipeline.wait();
     THEN("45 frames are published and none of the bad ones") {
@@ -309,9 +328,6 @@ SCENARIO("The pipeline config is validated with the key and the allowed range") 
   c.filter_budget_ms = 0.0;
   CHECK_THAT(c.validate(), Catch::StartsWith("filter_budget_ms: ") && Catch::Contains("0.1 .. 1000"));
   c = PipelineConfig{};
-  c.map_save_period_s = 0.5;
-  CHECK_THAT(c.validate(), Catch::StartsWith("map_save_period_s: ") && Catch::Contains("0 (only at stop) or 1 .. 86400"));
-  c = PipelineConfig{};
   c.threads.topology.nice = 40;
   CHECK_THAT(c.validate(), Catch::StartsWith("threads.topology.nice: "));
   ManualClock clock;
@@ -320,8 +336,25 @@ SCENARIO("The pipeline config is validated with the key and the allowed range") 
   FakeSegmentation segmentation(10);
   FakeTopology topology(clock, 1, 1e-3);
   RecordingSink sink;
-  CHECK_THROWS_WITH(Pipeline(c, source, fingerprint, segmentation, topology, sink, clock),
-                    Catch::StartsWith("pipeline.threads.topology.nice"));
+  CHECK_THROWS_WITH(
+      Pipeline(c, MapConfig{}, WatchdogConfig{}, source, fingerprint, segmentation, topology, sink, clock),
+      Catch::StartsWith("pipeline.threads.topology.nice"));
+  THEN("the map and watchdog sections are validated with their own keys") {
+    MapConfig map;
+    CHECK(map.validate().empty());
+    map.save_period_s = 0.5;
+    CHECK_THAT(map.validate(),
+               Catch::StartsWith("save_period_s: ") && Catch::Contains("0 (only at stop) or 1 .. 86400"));
+    CHECK_THROWS_WITH(Pipeline(PipelineConfig{}, map, WatchdogConfig{}, source, fingerprint, segmentation,
+                               topology, sink, clock),
+                      Catch::StartsWith("map.save_period_s: "));
+    WatchdogConfig watchdog;
+    CHECK(watchdog.validate().empty());
+    watchdog.heartbeat_timeout_s = 0.1;
+    CHECK_THROWS_WITH(Pipeline(PipelineConfig{}, MapConfig{}, watchdog, source, fingerprint, segmentation,
+                               topology, sink, clock),
+                      Catch::StartsWith("watchdog.heartbeat_timeout_s: ") && Catch::Contains("0.5 .. 600"));
+  }
 }
 
 SCENARIO("Latency summaries: median, nearest-rank p99 and max") {
@@ -365,9 +398,9 @@ SCENARIO("GIVEN a camera reconnecting for longer than the heartbeat limit THEN t
   RecordingSink sink;
   PipelineConfig config = losslessConfig();
   config.queues.overflow = QueueOverflow::DropOldest;
-  config.heartbeat_timeout_s = 5.0;
   config.status_period_s = 1.0;
-  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  Pipeline pipeline(config, savedAtStop(), patientWatchdog(5.0), source, fingerprint, segmentation, topology,
+                    sink, clock);
   pipeline.start();
   source.waitForCalls(1);
   WHEN("12 s pass in steps of 3 s (each step: the capture thread comes back from the source and beats)") {
@@ -401,8 +434,8 @@ SCENARIO("GIVEN a source hung inside next() THEN the pipeline is unhealthy (stal
   FakeTopology topology(clock, 1, 1e-3);
   RecordingSink sink;
   PipelineConfig config = losslessConfig();
-  config.heartbeat_timeout_s = 5.0;
-  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  Pipeline pipeline(config, savedAtStop(), patientWatchdog(5.0), source, fingerprint, segmentation, topology,
+                    sink, clock);
   pipeline.start();
   source.waitForCalls(1);
   CHECK(pipeline.healthy());
@@ -438,8 +471,8 @@ SCENARIO("GIVEN frames that keep arriving but all fail WHEN none is fingerprinte
   FakeTopology topology(clock, 1, 1e-3);
   RecordingSink sink;
   PipelineConfig config = losslessConfig();
-  config.heartbeat_timeout_s = 5.0;
-  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  Pipeline pipeline(config, savedAtStop(), patientWatchdog(5.0), source, fingerprint, segmentation, topology,
+                    sink, clock);
   // Waits until `n` more frames failed (the one counted first then has its failure time stored).
   auto waitForFailures = [&](int n) {
     const int target = failed.load() + n;
@@ -484,7 +517,8 @@ SCENARIO("GIVEN a publisher that falls far behind WHEN drop-oldest queues overfl
   config.queues.fingerprints = 1024;
   config.queues.segmented = 16;
   config.queues.results = 16;
-  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  Pipeline pipeline(config, savedAtStop(), patientWatchdog(), source, fingerprint, segmentation, topology,
+                    sink, clock);
   pipeline.start();
   pipeline.wait();
   REQUIRE(pipeline.error().empty());
@@ -547,8 +581,9 @@ SCENARIO("GIVEN a slow disk WHEN the map is saved periodically THEN frames keep 
     }
   };
   PipelineConfig config = losslessConfig();
-  config.map_save_period_s = 1.0;
-  Pipeline pipeline(config, source, fingerprint, segmentation, topology, sink, clock);
+  MapConfig map = savedAtStop();
+  map.save_period_s = 1.0;
+  Pipeline pipeline(config, map, patientWatchdog(), source, fingerprint, segmentation, topology, sink, clock);
   pipeline.start();
   const bool all_published = sink.waitForFramesFor(200, std::chrono::seconds(10));
   const int writes_while_blocked = writes_started.load();

@@ -1,18 +1,19 @@
-// OfflineMapper's bookkeeping (segmentation only, as `toposlam segment`) and the run-folder writers (docs/run-folder.md), with fake
+// OfflineRunner's bookkeeping (segmentation only, as `toposlam segment`) and the run folder made from its rows
+// (src/run_folder, docs/run-folder.md), with fake
 // fingerprints and a table similarity: frame rows get their place once it closes, dropped places are
 // -1, CSV headers and columns are exact, the lambda2 plot marks each valley-closed border.
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "segmentation/fake_similarity.hpp"
-#include "toposlam/eval/run_files.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
-#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 
 using toposlam::test::fakeFingerprint;
 using toposlam::test::TableSimilarity;
@@ -20,24 +21,31 @@ using toposlam::test::thesisConfig;
 
 namespace {
 
-std::vector<std::string> linesOf(const std::string& text) {
+std::vector<std::string> linesOf(const std::filesystem::path& path) {
   std::vector<std::string> lines;
-  std::istringstream in(text);
+  std::ifstream in(path);
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   return lines;
+}
+
+std::filesystem::path scratchFolder(const std::string& name) {
+  const auto dir = std::filesystem::path(TOPOSLAM_BINARY_DIR) / "test-scratch" / "pipeline" / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 }  // namespace
 
 TEST_CASE(
-    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineMapper THEN the rows and "
+    "GIVEN three blocks, the middle one keypoint-poor WHEN run through OfflineRunner THEN the rows and "
     "CSV files follow docs/run-folder.md",
     "[segmentation][run]") {
   auto block = [](int f) { return f < 40 ? 0 : (f < 80 ? 1 : 2); };
   TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
   toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);  // unused: fingerprints are given
   toposlam::FiedlerSegmentationStage segmentation_stage(thesisConfig(), similarity, 1);
-  toposlam::OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+  toposlam::OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
   for (int f = 0; f < 120; ++f) {
     std::string name = "f";
     name.append(std::to_string(f)).append(".png");
@@ -56,24 +64,24 @@ TEST_CASE(
   CHECK(run.frames[50].in_dropped_place);
   CHECK(run.frames[100].place == 1);
 
-  std::ostringstream frames_csv, places_csv, dropped_csv;
-  toposlam::writeFramesCsv(frames_csv, run, {7, 9});
-  toposlam::writePlacesCsv(places_csv, run.places, {7, 9});
-  toposlam::writePlacesCsv(dropped_csv, run.dropped_places);
-  const auto frames = linesOf(frames_csv.str());
+  const auto dir = scratchFolder("run-writers");
+  toposlam::writeFrames(dir, toposlam::frameRows(run, {7, 9}), toposlam::FrameColumns::Segmentation);
+  toposlam::writePlaces(dir, toposlam::placeRows(run.places, {7, 9}));
+  toposlam::writeDroppedPlaces(dir, toposlam::placeRows(run.dropped_places));
+  const auto frames = linesOf(dir / "frames.csv");
   REQUIRE(frames.size() == 121);
   CHECK(frames[0] == "frame,time,name,lambda2,place,node");
   CHECK(frames[1] == "0,0.000000,f0.png,,0,7");  // one frame in the window: no lambda2 yet
   CHECK(frames[2] == "1,0.500000,f1.png,2.000000,0,7");
   CHECK(frames[71] == "70,35.000000,f70.png,1.041667,-1,-1");  // a full window inside block 1
   CHECK(frames[101].substr(frames[101].size() - 4) == ",1,9");
-  const auto places = linesOf(places_csv.str());
+  const auto places = linesOf(dir / "places.csv");
   REQUIRE(places.size() == 3);
   CHECK(places[0] == "place,first,last,representative,keypoints,node");
   CHECK(places[1].rfind("0,0,39,", 0) == 0);
   CHECK(places[2].rfind("1,80,119,", 0) == 0);
   CHECK(places[2].substr(places[2].size() - 5) == ",40,9");
-  const auto dropped = linesOf(dropped_csv.str());
+  const auto dropped = linesOf(dir / "dropped_places.csv");
   REQUIRE(dropped.size() == 2);
   CHECK(dropped[1].rfind("0,40,79,", 0) == 0);
   CHECK(dropped[1].substr(dropped[1].size() - 5) == ",3,-1");
@@ -106,12 +114,9 @@ TEST_CASE(
     row.place = 0;
     run.frames.push_back(row);
   }
-  const std::string path = std::string(TOPOSLAM_BINARY_DIR) + "/frames-quoted-names.csv";
-  {
-    std::ofstream out(path, std::ios::binary);
-    toposlam::writeFramesCsv(out, run, {3});
-  }
-  const std::vector<toposlam::eval::FrameRecord> back = toposlam::eval::loadFrames(path);
+  const auto dir = scratchFolder("frames-quoted-names");
+  toposlam::writeFrames(dir, toposlam::frameRows(run, {3}), toposlam::FrameColumns::Segmentation);
+  const std::vector<toposlam::FrameRecord> back = toposlam::loadFrames((dir / "frames.csv").string());
   REQUIRE(back.size() == names.size());
   for (std::size_t f = 0; f < names.size(); ++f) {
     INFO("frame " << f);

@@ -1,5 +1,5 @@
 // The daemon's stages (FiedlerSegmentationStage -> ParticleFilterTopologyStage) and `toposlam map`'s
-// OfflineMapper on the same frames, with the filter's sequence evidence on (docs/topology.md): the same
+// OfflineRunner on the same frames, with the filter's sequence evidence on (docs/topology.md): the same
 // places, the same evidence and the same nodes. Two laps of three blocks of near-identical frames.
 #include <catch2/catch.hpp>
 
@@ -10,7 +10,7 @@
 #include "../segmentation/fake_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/clock.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 
 using namespace toposlam;
 
@@ -40,7 +40,7 @@ SequenceEvidenceConfig evidenceOn() {
 double timeOf(int f) { return 0.2 * f; }  // 5 fps: keyframes once a second, a lap of 24 s
 }  // namespace
 
-TEST_CASE("GIVEN sequence evidence on WHEN the daemon's stages and the offline mapper see the same frames THEN "
+TEST_CASE("GIVEN sequence evidence on WHEN the daemon's stages and the offline runner see the same frames THEN "
           "places, evidence and nodes are the same",
           "[pipeline][evidence]") {
   const test::TableSimilarity similarity(twoLaps);
@@ -61,18 +61,18 @@ TEST_CASE("GIVEN sequence evidence on WHEN the daemon's stages and the offline m
   }
   if (auto last = segmenter.finish()) mapOnline(*last);
 
-  // The offline mapper, on stages of its own.
+  // The offline runner, on stages of its own.
   VpackFingerprintStage fingerprints(VpackConfig{}, nullptr);  // unused: fingerprints are made up
   FiedlerSegmentationStage offline_segmenter(segmentation(), similarity, 1, {}, evidenceOn());
   ParticleFilterTopologyStage offline_filter(topology(), similarity, clock, {64, 3});
-  OfflineMapper mapper(fingerprints, offline_segmenter, &offline_filter);
+  OfflineRunner runner(fingerprints, offline_segmenter, &offline_filter);
   for (int f = 0; f < 2 * kLap; ++f) {
-    const SegmenterStep step = mapper.segment(timeOf(f), "", test::fakeFingerprint(f));
-    if (step.closed_place) mapper.mapPlace(*step.closed_place);
+    const SegmenterStep step = runner.segment(timeOf(f), "", test::fakeFingerprint(f));
+    if (step.closed_place) runner.mapPlace(*step.closed_place);
   }
-  if (auto last = mapper.finishTraversal()) mapper.mapPlace(*last);
+  if (auto last = runner.finishTraversal()) runner.mapPlace(*last);
 
-  const SegmentationRun& run = mapper.run();
+  const SegmentationRun& run = runner.run();
   REQUIRE(run.places.size() == stage_places.size());
   REQUIRE(stage_places.size() == 6u);  // three blocks a lap
   for (std::size_t p = 0; p < stage_places.size(); ++p) {
@@ -83,7 +83,7 @@ TEST_CASE("GIVEN sequence evidence on WHEN the daemon's stages and the offline m
   // The second lap's places carry evidence on their first-lap twins, from its second place on (in the
   // first, the evidence D still builds up, by (1 - decay) z a keyframe, over most of its 8 keyframes).
   for (std::size_t p = 4; p < 6; ++p) CHECK(stage_places[p].evidence[p - 3] >= 0.99 * 0.8);
-  const std::vector<std::int64_t> offline_nodes = mapper.placeNodes();
+  const std::vector<std::int64_t> offline_nodes = runner.placeNodes();
   const TopologySnapshot online = filter.topology();
   std::vector<std::int64_t> online_nodes(stage_places.size(), -1);
   for (const TopologyNode& node : online.nodes)

@@ -50,22 +50,6 @@ struct RecordSettings {
   int queue_frames = 16;       ///< frames waiting for the writer before the oldest is dropped, 1 .. 1024
 };
 
-/// map.*: what toposlamd does with the map file at start (the Pipeline saves it: PipelineConfig::map_path).
-struct MapConfig {
-  bool load_at_start = true;         ///< map.load_at_start: resume from pipeline.map_path if it exists
-  /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
-  bool resume_other_source = false;
-  /// map.source_from_start: a resumed map's images: source starts from its first frame, not after the
-  /// last frame the map holds
-  bool source_from_start = false;
-  double max_mb = 256;               ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
-};
-
-/// watchdog.*: the systemd watchdog (the Pipeline's own heartbeat: PipelineConfig::heartbeat_timeout_s).
-struct WatchdogConfig {
-  bool enabled = true;  ///< watchdog.enabled: ping systemd while the pipeline is healthy
-};
-
 struct DaemonConfig {
   /// Method preset (method_preset.hpp): "default" (measured on real frames) or "thesis"; it sets every
   /// stage's settings before the other keys are read.
@@ -76,11 +60,10 @@ struct DaemonConfig {
   RecordSettings record;
   /// log_level: trace, debug, info, warn or error (toposlamd --log-level overrides it).
   std::string log_level = "info";
-  MapConfig map;                  ///< map.load_at_start, map.resume_other_source, map.max_mb
-  WatchdogConfig watchdog;        ///< watchdog.enabled
-  /// Queues, threads, budgets. The Pipeline saves the map and watches its threads itself, so map.path,
-  /// map.save_period_s and watchdog.heartbeat_timeout_s are its members (PipelineConfig).
-  PipelineConfig pipeline;
+  /// map.*: the Pipeline saves the map (path, save_period_s); toposlamd loads it at start (the rest).
+  MapConfig map;
+  WatchdogConfig watchdog;  ///< watchdog.*: the Pipeline's heartbeat, toposlamd's systemd pings
+  PipelineConfig pipeline;  ///< pipeline.*: queues, threads, budgets
   VpackConfig fingerprint;
   FingerprintStageConfig fingerprint_stage;  ///< fingerprint.workers
   NgramSimilarityConfig similarity;

@@ -17,30 +17,11 @@
 
 #include "toposlam/eval/metrics.hpp"
 #include "toposlam/eval/recognition.hpp"
-#include "toposlam/eval/run_files.hpp"
+#include "toposlam/eval/ground_truth.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 
 namespace toposlam::eval {
 
-/// Everything a run folder holds that eval and report read. Only frames.csv is required.
-struct RunData {
-  std::string dir;
-  std::vector<FrameRecord> frames;
-  std::vector<PlaceRecord> places;          ///< places.csv (kept places), empty when absent
-  std::vector<PlaceRecord> dropped_places;  ///< dropped_places.csv, empty when absent
-  std::optional<TopologyFile> topology;     ///< topology.json (from `map`)
-  std::vector<TimingRow> timing;            ///< timing.csv
-  bool has_frame_matches = false;           ///< frames.csv has the match columns of `map`
-  std::vector<std::string> sources;         ///< source.txt: the run's source URIs, one per traversal
-  /// settings.txt ("key = value" lines, written by `map`): what the run was made with, in file order.
-  std::vector<std::pair<std::string, std::string>> settings;
-  /// First frame of each traversal: frame 0, then every frame whose time is below the previous frame's
-  /// (a new source of `map`), unless set explicitly (evenly split, see splitTraversals).
-  std::vector<std::int64_t> traversal_starts;
-};
-
-/// Throws RunFileError naming the file (and line) when the folder or frames.csv is missing, a file is
-/// malformed, or a place lies outside frames.csv (a damaged run folder).
-RunData loadRun(const std::string& dir);
 /// `count` traversals of equal length (count >= 1).
 std::vector<std::int64_t> splitTraversals(std::int64_t frame_count, int count);
 

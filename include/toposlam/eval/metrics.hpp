@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "toposlam/eval/run_files.hpp"
+#include "toposlam/eval/ground_truth.hpp"
 
 namespace toposlam::eval {
 

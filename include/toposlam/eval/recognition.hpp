@@ -12,7 +12,7 @@
 // Two layouts: one sequence against its own past (reference = earlier frames, candidates at least
 // min_gap frames back, the loop-closure setting), or a query set against a separate reference set.
 //
-// Pure functions and value types; no I/O (the loaders live in run_files.hpp). Thread-safe.
+// Pure functions and value types; no I/O (the loaders live in ground_truth.hpp). Thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "toposlam/eval/metrics.hpp"
-#include "toposlam/eval/run_files.hpp"
+#include "toposlam/eval/ground_truth.hpp"
 
 namespace toposlam::eval {
 

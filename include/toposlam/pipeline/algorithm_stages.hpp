@@ -80,7 +80,7 @@ struct MotionSample {
 /// are applied to a MotionGate, in order, before the next frame; each frame then asks the gate at its
 /// captured_at_s. Without samples the segmentation is exactly the one without motion.
 ///
-/// Traversals (the offline commands' sources, OfflineMapper): beginTraversal() starts a fresh window and
+/// Traversals (the offline commands' sources, OfflineRunner): beginTraversal() starts a fresh window and
 /// clock; places go on being numbered over the whole run, and the sequence evidence carries on. The
 /// daemon has one traversal.
 class FiedlerSegmentationStage final : public SegmentationStage {
@@ -102,7 +102,7 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   void beginTraversal();
   /// The place the last process() or finish() closed, kept or dropped, numbered over the run (kept and
   /// dropped places each from 0, in closing order); its representative is not kept here. Empty when that
-  /// call closed none. For the run folder's places.csv and dropped_places.csv (OfflineMapper).
+  /// call closed none. For the run folder's places.csv and dropped_places.csv (OfflineRunner).
   const std::optional<SegmentedPlace>& lastClosedPlace() const { return last_closed_; }
   /// The segmenter's settings.
   const FiedlerSegmenterConfig& segmenterConfig() const { return segmenter_->config(); }

@@ -10,17 +10,17 @@
 // buffer_lease keeps the driver buffer); the fingerprint thread releases it as soon as the fingerprint and
 // a small thumbnail are made. The topology filter's step for a place is spread over the following frames:
 // per frame the topology thread spends at most `filter_budget_ms` in TopologyStage::advance(). A status is
-// published every `status_period_s`. The map is saved atomically every `map_save_period_s` and at stop:
-// the topology thread takes an in-memory snapshot, the map writer thread writes it (fsync off the frame
-// path).
+// published every `status_period_s`. The map is saved atomically every `MapConfig::save_period_s` and at
+// stop: the topology thread takes an in-memory snapshot, the map writer thread writes it (fsync off the
+// frame path).
 //
 // The capture thread reads the source with a bounded wait (FrameSource::nextFor), so it keeps beating
 // while a camera is silent or reconnecting: that is healthy, and the status says "reconnecting". A stage
-// thread waiting for input is healthy too; only a thread stuck inside its work for heartbeat_timeout_s
-// (a stalled pipeline) makes healthy() false. So does a pipeline that is busy without progress: frames
-// keep arriving but every one fails (skipped by the source, e.g. V4L2 error buffers, or refused by the
-// fingerprint stage) and none has been fingerprinted for heartbeat_timeout_s. requestStop() interrupts
-// the source.
+// thread waiting for input is healthy too; only a thread stuck inside its work for the watchdog's
+// heartbeat_timeout_s (a stalled pipeline) makes healthy() false. So does a pipeline that is busy without
+// progress: frames keep arriving but every one fails (skipped by the source, e.g. V4L2 error buffers, or
+// refused by the fingerprint stage) and none has been fingerprinted for heartbeat_timeout_s.
+// requestStop() interrupts the source.
 //
 // Thread-safety: start(), requestStop() and wait() from the owning thread; status(), healthy(),
 // finished() from any thread.
@@ -38,6 +38,7 @@
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/pipeline/stages.hpp"
+#include "toposlam/pipeline/status_collector.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 
 namespace toposlam {
@@ -67,15 +68,13 @@ struct PipelineThreads {
   ThreadSettings map_writer{"tsl-mapsave"};
 };
 
+/// pipeline.*: queues, threads, budgets.
 struct PipelineConfig {
   PipelineQueues queues;
   PipelineThreads threads;
   double filter_budget_ms = 5.0;     ///< topology work per frame, milliseconds (0.1 .. 1000)
   double status_period_s = 1.0;      ///< status message period (0.1 .. 60)
   int thumbnail_width = 160;         ///< place-event thumbnail width in pixels (16 .. 1280), height keeps aspect
-  std::string map_path;              ///< where the map is saved; empty = never saved
-  double map_save_period_s = 60.0;   ///< periodic save, seconds (0 = only at stop; else 1 .. 86400)
-  double heartbeat_timeout_s = 5.0;  ///< a thread silent this long makes healthy() false (0.5 .. 600)
   bool record_latencies = false;     ///< keep every frame's capture-to-publish latency (benchmark)
   /// OpenCV's own thread pool, set at start (cv::setNumThreads, process-wide). 1: OpenCV runs each call
   /// on the calling stage thread, so the only threads are the table's and the fingerprint workers
@@ -85,19 +84,44 @@ struct PipelineConfig {
   std::string validate() const;
 };
 
+/// map.*: the map file. The Pipeline saves it (path, save_period_s); toposlamd decides at start what it
+/// loads (load_at_start, resume_other_source, source_from_start, max_mb).
+struct MapConfig {
+  std::string path;  ///< map.path: where the map is saved; empty = never saved
+  /// map.save_period_s: periodic save, seconds (0 = only at stop; else 1 .. 86400)
+  double save_period_s = 60.0;
+  bool load_at_start = true;  ///< map.load_at_start: resume from `path` if it exists
+  /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
+  bool resume_other_source = false;
+  /// map.source_from_start: a resumed map's images: source starts from its first frame, not after the
+  /// last frame the map holds
+  bool source_from_start = false;
+  double max_mb = 256;  ///< map.max_mb: a bigger map file is refused unread, 1 .. 65536 MB
+  /// "" or "<key>: <problem, allowed range>" with keys relative to the map section.
+  std::string validate() const;
+};
+
+/// watchdog.*: the Pipeline's heartbeat (healthy()) and toposlamd's systemd watchdog pings.
+struct WatchdogConfig {
+  bool enabled = true;               ///< watchdog.enabled: ping systemd while the pipeline is healthy
+  double heartbeat_timeout_s = 5.0;  ///< a thread silent this long makes healthy() false (0.5 .. 600)
+  /// "" or "<key>: <problem, allowed range>" with keys relative to the watchdog section.
+  std::string validate() const;
+};
+
 /// One line for systemd's STATUS= and the log: "running: 29.8 fps, latency p99 12.0 ms, 4 places, map rev 4,
 /// 0 dropped; camera streaming (0 reconnects, 0 lost by the driver)"; while the camera is away the camera
 /// part reads "camera reconnecting (attempt N, ...)".
 std::string statusLine(const PipelineStatus& status);
 
-/// Median, p99 (nearest rank) and max of `values_ms`; all zero when empty. Reorders `values_ms`.
-LatencyStats summarizeLatencies(std::vector<double>& values_ms);
 
 class Pipeline {
  public:
-  /// The pipeline borrows everything; all must outlive it. Throws std::invalid_argument on a bad config.
-  Pipeline(const PipelineConfig& config, FrameSource& source, FingerprintStage& fingerprint,
-           SegmentationStage& segmentation, TopologyStage& topology, PipelineSink& sink, const Clock& clock);
+  /// The pipeline copies the three configs and borrows the rest; all must outlive it. Throws
+  /// std::invalid_argument naming the key ("pipeline.queues.frames: ...") on a bad config.
+  Pipeline(const PipelineConfig& config, const MapConfig& map, const WatchdogConfig& watchdog,
+           FrameSource& source, FingerprintStage& fingerprint, SegmentationStage& segmentation,
+           TopologyStage& topology, PipelineSink& sink, const Clock& clock);
   ~Pipeline();  ///< requests stop and joins
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
@@ -113,8 +137,8 @@ class Pipeline {
   /// True once every thread has ended (end of stream or stop).
   bool finished() const { return finished_threads_.load() == kThreadCount + 1; }
   /// False when a running stage thread has been inside its work (not waiting for input or a frame) for
-  /// heartbeat_timeout_s, when frames keep failing and none was fingerprinted for heartbeat_timeout_s,
-  /// or a stage failed (watchdog food). A camera away or silent is healthy.
+  /// the watchdog's heartbeat_timeout_s, when frames keep failing and none was fingerprinted for
+  /// heartbeat_timeout_s, or a stage failed (watchdog food). A camera away or silent is healthy.
   bool healthy() const;
   /// What makes healthy() false, as "capture 6.0 s, topology 7.5 s" (stage threads, seconds since their
   /// last heartbeat) and "frames failing 6.0 s" (none fingerprinted meanwhile); "" when nothing. The
@@ -143,6 +167,8 @@ class Pipeline {
   void segmentationLoop();
   void topologyLoop();
   void publisherLoop();
+  /// The counters a status reads (publisher thread); `published`: the publisher's own count.
+  StatusCounters statusCounters(std::int64_t published) const;
   void mapWriterLoop();
   /// Snapshot now (topology thread, when idle) and hand it to the map writer; `final` at stop.
   void saveMap(bool final);
@@ -155,6 +181,8 @@ class Pipeline {
   bool forward(Q& queue, T&& item);
 
   PipelineConfig config_;
+  MapConfig map_;
+  WatchdogConfig watchdog_;
   FrameSource& source_;
   FingerprintStage& fingerprint_;
   SegmentationStage& segmentation_;

@@ -161,7 +161,7 @@ RunResult runOnce(const DaemonConfig& base, const PipelineBenchOptions& o, const
   out.cores = cores;
   out.mode = paced ? "paced" : "throughput";
   DaemonConfig c = base;
-  c.pipeline.map_path.clear();
+  c.map.path.clear();
   c.pipeline.record_latencies = true;
   c.pipeline.queues.overflow = paced ? QueueOverflow::DropOldest : QueueOverflow::Block;
   SteadyClock clock;
@@ -188,7 +188,8 @@ RunResult runOnce(const DaemonConfig& base, const PipelineBenchOptions& o, const
     NgramSimilarity similarity(c.similarity);
     FiedlerSegmentationStage segmentation(c.segmentation, similarity, 600, c.segmentation_stage.motion);
     ParticleFilterTopologyStage topology(c.topology, similarity, clock, c.topology_stage);
-    Pipeline pipeline(c.pipeline, source, fingerprint, segmentation, topology, sink, clock);
+    Pipeline pipeline(c.pipeline, c.map, c.watchdog, source, fingerprint, segmentation, topology, sink,
+                      clock);
     const double t0 = clock.now();
     pipeline.start();
     pipeline.wait();  // the source ends after o.frames frames

@@ -27,7 +27,7 @@ struct EvalCommandOptions {
 };
 
 void runEval(const EvalCommandOptions& o) {
-  const eval::RunData run = eval::loadRun(o.run_dir);
+  const RunData run = loadRun(o.run_dir);
   const eval::Truth truth = eval::loadTruth(o.truth);
   const eval::EvalResult result = eval::evaluate(run, truth, o.eval);
   const std::filesystem::path json_path = std::filesystem::path(o.run_dir) / "eval.json";

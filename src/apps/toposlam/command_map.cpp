@@ -30,7 +30,6 @@
 #include "offline_run_io.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/core/json_writer.hpp"
-#include "toposlam/core/svg_plot.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
@@ -39,7 +38,8 @@
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/programs.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"
@@ -229,8 +229,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   if (const std::string problem = evidence.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
   // Thumbnails are the daemon's (place events); the offline run keeps none.
   FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
-  OfflineMapper mapper(fingerprint_stage, segmentation_stage, topology.get());
-  std::vector<FrameTiming> timing;
+  OfflineRunner runner(fingerprint_stage, segmentation_stage, topology.get());
+  std::vector<TimingRow> timing;
   std::int64_t refused = 0;
   // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
   std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
@@ -240,7 +240,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (place.dropped) return;
     if (progress != nullptr) progress->clearLine();
     const auto start = std::chrono::steady_clock::now();
-    const MappedPlace mapped = *mapper.mapPlace(place);
+    const MappedPlace mapped = *runner.mapPlace(place);
     if (!timing.empty()) timing.back().filter_ms = *timing.back().filter_ms + msSince(start);
     origins.push_back(ObservationOrigin{run_number, place.representative_frame});
     const TopologyEstimate& e = mapped.estimate;
@@ -253,7 +253,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   for (const std::string& uri : o.sources) {
     std::unique_ptr<FrameSource> source = openSource(uri);
     std::cerr << "map: " << source->describe() << "\n";
-    mapper.beginTraversal();  // fresh segmentation window per traversal
+    runner.beginTraversal();  // fresh segmentation window per traversal
     // Each traversal has its own clock, with any step back inside it cut out (the segmentation stage's;
     // docs/reliability.md, "Clock jumps"); the next source starts its own, so where it goes back a new
     // traversal begins (frames.csv).
@@ -262,12 +262,13 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::int64_t read = 0;
     while (std::optional<Frame> frame = source->next()) {
       source_progress.update(++read);
-      FrameTiming t;
+      TimingRow t;
+      t.frame = static_cast<std::int64_t>(timing.size());
       t.filter_ms = 0.0;
       auto start = std::chrono::steady_clock::now();
       std::shared_ptr<const Fingerprint> fingerprint;
       try {
-        fingerprint = mapper.fingerprint(frame->image, frame->grey);
+        fingerprint = runner.fingerprint(frame->image, frame->grey);
       } catch (const std::invalid_argument& e) {
         // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
         if (refused++ == 0) std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
@@ -280,13 +281,13 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
       if (motion) motion->feedUpTo(frame->timestamp_s, segmentation_stage);
-      const SegmenterStep step = mapper.segment(frame->timestamp_s, name, std::move(fingerprint));
+      const SegmenterStep step = runner.segment(frame->timestamp_s, name, std::move(fingerprint));
       t.segment_ms = msSince(start);
       timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
       if (step.closed_place) mapPlace(*step.closed_place);
     }
-    if (auto last = mapper.finishTraversal()) mapPlace(*last);
+    if (auto last = runner.finishTraversal()) mapPlace(*last);
     source_progress.finish();
     progress = nullptr;
     if (source->skippedFrames() > 0)
@@ -295,7 +296,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       std::cerr << timelineSummary(timeline, "map") << "\n";
   }
   if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
-  const SegmentationRun& all = mapper.run();
+  const SegmentationRun& all = runner.run();
   if (all.frames.empty())
     throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
                              " refused)");
@@ -307,7 +308,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
 
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter.estimate(3);
-  const std::vector<std::int64_t> place_nodes = mapper.placeNodes();
+  const std::vector<std::int64_t> place_nodes = runner.placeNodes();
   {
     // What the run was made with, for the report's header (and a reader of the run folder).
     const TopologyFilterConfig& topo = filter.config();
@@ -316,7 +317,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       text << v;
       return text.str();
     };
-    writeSettingsTxt(out_dir / "settings.txt",
+    writeSettings(out_dir,
                      {{"toposlam", TOPOSLAM_VERSION},
                       {"preset", preset.name},
                       {"keypoints", std::string(toString(vpack.keypoints.backend)) + ", at most " +
@@ -346,57 +347,46 @@ void runMap(const MapOptions& o, bool filter_options_given) {
                                                         " frames back"}});
   }
   {
-    OutputFile out = openOutput(out_dir / "source.txt");
-    for (const std::string& uri : o.sources) out << absoluteSourceUri(uri) << "\n";
-    out.commit();
+    std::vector<std::string> uris;
+    for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
+    writeSources(out_dir, uris);
   }
   // Frame-level loop closures (docs/topology.md): each frame on a node seen on an earlier visit gets that
   // visit's most similar frame, scored by similarity x the place's node probability at its step.
-  FrameLoopColumns loop;
+  std::vector<FrameRecord> frame_rows = frameRows(all, place_nodes);
   {
     std::vector<std::int64_t> place_of_frame;
     for (const auto& row : all.frames) place_of_frame.push_back(row.place);
-    loop.place_probability.assign(all.places.size(), 0.0);
-    for (const MappedPlace& step : mapper.steps()) {
+    std::vector<double> place_probability(all.places.size(), 0.0);
+    for (const MappedPlace& step : runner.steps()) {
       const auto p = static_cast<std::size_t>(step.place.index);
-      if (p < loop.place_probability.size()) loop.place_probability[p] = step.estimate.current_node_probability;
+      if (p < place_probability.size()) place_probability[p] = step.estimate.current_node_probability;
     }
     frame_fingerprints.resize(all.frames.size());
     std::vector<double> time_s;
     for (const auto& row : all.frames) time_s.push_back(row.time_s);
     const std::vector<FrameMatch> matches =
         !by_sequence
-            ? matchFramesToEarlierVisits(place_of_frame, place_nodes, loop.place_probability, frame_fingerprints,
+            ? matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
                                          similarity, o.loop_min_gap)
             : matchFramesBySequence(time_s, frame_fingerprints, similarity, sequence_loops);
-    for (const FrameMatch& m : matches) {
-      loop.match_frame.push_back(m.match_frame);
-      loop.match_score.push_back(m.score);
+    for (std::size_t f = 0; f < frame_rows.size(); ++f) {
+      FrameRecord& row = frame_rows[f];
+      if (row.place >= 0 && static_cast<std::size_t>(row.place) < place_probability.size())
+        row.node_probability = place_probability[static_cast<std::size_t>(row.place)];
+      if (f < matches.size()) {
+        row.match = matches[f].match_frame;
+        row.match_score = matches[f].score;
+      }
     }
   }
   frame_fingerprints.clear();
-  {
-    OutputFile out = openOutput(out_dir / "frames.csv");
-    writeFramesCsv(out, all, place_nodes, &loop);
-    out.commit();
-  }
-  {
-    OutputFile out = openOutput(out_dir / "places.csv");
-    writePlacesCsv(out, all.places, place_nodes);
-    out.commit();
-  }
-  {
-    OutputFile out = openOutput(out_dir / "dropped_places.csv");
-    writePlacesCsv(out, all.dropped_places);
-    out.commit();
-  }
-  writeTimingCsv(out_dir / "timing.csv", timing);
-  {
-    OutputFile out = openOutput(out_dir / "lambda2.svg");
-    out << renderSvgLinePlot(lambda2Plot(
-        all, segmenter_config, "Fiedler value over " + std::to_string(o.sources.size()) + " source(s)"));
-    out.commit();
-  }
+  writeFrames(out_dir, frame_rows, FrameColumns::WithLoopClosures);
+  writePlaces(out_dir, placeRows(all.places, place_nodes));
+  writeDroppedPlaces(out_dir, placeRows(all.dropped_places));
+  writeTiming(out_dir, timing);
+  writeLambda2Plot(out_dir, all, segmenter_config,
+                   "Fiedler value over " + std::to_string(o.sources.size()) + " source(s)");
 
   // Nodes and edges of the best topology (over all observations, resumed ones included): the topology
   // stage's snapshot, the one toposlamd publishes. Observations before this run's first are the resumed
@@ -421,58 +411,34 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   std::map<std::pair<int, int>, int> edges;
   for (const TopologyEdge& edge : best.edges) edges[{edge.from, edge.to}] = edge.count;
   {
-    OutputFile out = openOutput(out_dir / "topology.json");
-    JsonWriter json(out);
-    json.beginObject();
-    json.field("probability", final_estimate.best.probability);
-    json.field("particles", filter.config().particles);
-    json.field("current_node", final_estimate.current_node);
-    json.field("current_node_probability", final_estimate.current_node_probability);
-    json.field("effective_sample_size", final_estimate.effective_sample_size);
-    json.field("distinct_topologies", final_estimate.distinct_topologies);
-    json.field("earlier_places", first_observation);
-    json.key("nodes").beginArray();
+    TopologyFile file;
+    file.probability = final_estimate.best.probability;
+    file.particles = filter.config().particles;
+    TopologyFile::Estimate& e = file.estimate.emplace();
+    e.current_node = final_estimate.current_node;
+    e.current_node_probability = final_estimate.current_node_probability;
+    e.effective_sample_size = final_estimate.effective_sample_size;
+    e.distinct_topologies = final_estimate.distinct_topologies;
+    e.earlier_places = first_observation;
+    for (const TopologyHypothesis& h : final_estimate.alternatives)
+      e.alternatives.push_back(TopologyFile::Alternative{h.probability, h.node_count, h.first_difference});
     for (const auto& [node, info] : nodes) {
-      json.beginObject().field("id", node);
-      json.key("places").beginArray();
-      for (std::int64_t p : info.places) json.value(p);
-      json.endArray();
-      json.key("representative_frames").beginArray();
-      for (std::int64_t f : info.representative_frames) json.value(f);
-      json.endArray();
-      if (!info.earlier_places.empty()) {
-        json.key("earlier_places").beginArray();  // observations of the resumed map, before this run
-        for (std::int64_t p : info.earlier_places) json.value(p);
-        json.endArray();
-      }
-      json.endObject();
+      TopologyFile::Node& n = file.nodes.emplace_back();
+      n.id = node;
+      for (std::int64_t p : info.places) n.places.push_back(static_cast<int>(p));
+      n.representative_frames = info.representative_frames;
+      for (std::int64_t p : info.earlier_places) n.earlier_places.push_back(static_cast<int>(p));
     }
-    json.endArray();
-    json.key("edges").beginArray();
-    for (const auto& [edge, count] : edges) {
-      json.beginObject().field("from", edge.first).field("to", edge.second).field("count", count).endObject();
+    for (const auto& [edge, count] : edges) file.edges.push_back(TopologyFile::Edge{edge.first, edge.second, count});
+    for (const MappedPlace& s : runner.steps()) {
+      TopologyFile::Step& step = file.history.emplace_back();
+      step.place = static_cast<int>(s.place.index);
+      step.node = s.estimate.current_node;
+      step.probability = s.estimate.current_node_probability;
+      step.best_topology_probability = s.estimate.best.probability;
+      step.effective_sample_size = s.estimate.effective_sample_size;
     }
-    json.endArray();
-    json.key("alternatives").beginArray();
-    for (const TopologyHypothesis& h : final_estimate.alternatives) {
-      json.beginObject().field("probability", h.probability).field("nodes", h.node_count);
-      json.field("first_difference", h.first_difference).endObject();  // observation number
-    }
-    json.endArray();
-    json.key("history").beginArray();
-    for (const MappedPlace& s : mapper.steps()) {
-      json.beginObject()
-          .field("place", s.place.index)
-          .field("node", s.estimate.current_node)
-          .field("probability", s.estimate.current_node_probability)
-          .field("best_topology_probability", s.estimate.best.probability)
-          .field("effective_sample_size", s.estimate.effective_sample_size)
-          .endObject();
-    }
-    json.endArray();
-    json.endObject();
-    out << "\n";
-    out.commit();
+    writeTopology(out_dir, file);
   }
   {
     std::ostringstream dot;

@@ -25,6 +25,7 @@
 #include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/eval/report.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "lcmlog_run_folder.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -57,11 +58,8 @@ std::vector<fs::path> frameFolders(const ReportCommandOptions& o, std::vector<st
   }
   if (!folders.empty()) return folders;
   const fs::path run(o.run_dir);
-  if (fs::is_directory(run / "frames")) return {run / "frames"};
-  std::ifstream sources(run / "source.txt");
-  std::string line;
-  while (std::getline(sources, line)) {
-    if (line.empty()) continue;
+  if (fs::is_directory(run / run_files::kFramesFolder)) return {run / run_files::kFramesFolder};
+  for (const std::string& line : loadSources(run)) {
     std::string path = line.rfind("images:", 0) == 0 ? line.substr(7) : line;
     if (fs::is_directory(path)) {
       folders.emplace_back(path);
@@ -92,7 +90,7 @@ std::vector<std::string> imageFiles(const fs::path& folder) {
 /// names at all, else by position in the folder (sources without file names, e.g. sim: or video:). A named
 /// frame missing from a folder that holds the others stays missing rather than being replaced by its
 /// neighbour in the listing.
-std::vector<fs::path> thumbnailPaths(const eval::RunData& run, const std::vector<std::int64_t>& frames,
+std::vector<fs::path> thumbnailPaths(const RunData& run, const std::vector<std::int64_t>& frames,
                                      const std::vector<fs::path>& folders) {
   const std::vector<std::int64_t>& starts = run.traversal_starts;
   auto sourceOf = [&](std::int64_t f) { return static_cast<std::size_t>(eval::traversalOf(f, starts)); };
@@ -194,7 +192,7 @@ std::string runFolderOf(const std::string& run_dir) {
 void runReport(ReportCommandOptions o) {
   o.run_dir = runFolderOf(o.run_dir);
   eval::ReportInputs in;
-  in.run = eval::loadRun(o.run_dir);
+  in.run = loadRun(o.run_dir);
   in.title = o.title.empty()
                  ? "toposlam report: " + fs::path(o.run_dir).lexically_normal().filename().string()
                  : o.title;

@@ -16,7 +16,6 @@
 #include "commands.hpp"
 #include "motion_input.hpp"
 #include "offline_run_io.hpp"
-#include "toposlam/core/svg_plot.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/source_uri.hpp"
@@ -24,8 +23,8 @@
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/thread_os.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
-#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
 
@@ -60,12 +59,12 @@ void runSegment(const SegmentOptions& o) {
   const NgramSimilarity similarity(preset.similarity);
   // The daemon's stages without the topology one; thumbnails are the daemon's (place events), none here.
   FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
-  OfflineMapper pipeline(fingerprint_stage, segmentation_stage);
+  OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
 
   const std::int64_t total = source->frameCountHint();
   if (!o.quiet) std::cerr << "segment: " << source->describe() << "\n";
   std::vector<double> fingerprint_ms, segment_ms;
-  std::vector<FrameTiming> timing;
+  std::vector<TimingRow> timing;
   std::int64_t refused = 0;
   // The window's clock: the frames' timestamps with any step back cut out (the segmentation stage's;
   // docs/reliability.md, "Clock jumps"); frames.csv records it. Motion is looked up at the frame's own
@@ -93,7 +92,7 @@ void runSegment(const SegmentOptions& o) {
     if (motion) motion->feedUpTo(frame->timestamp_s, segmentation_stage);
     pipeline.segment(frame->timestamp_s, frame->name, std::move(fingerprint));
     segment_ms.push_back(segment_watch.elapsedMs());
-    timing.push_back(FrameTiming{fingerprint_ms.back(), segment_ms.back(), std::nullopt});
+    timing.push_back(TimingRow{static_cast<std::int64_t>(timing.size()), fingerprint_ms.back(), segment_ms.back(), std::nullopt});
   }
   pipeline.finish();
   progress.finish();
@@ -107,32 +106,12 @@ void runSegment(const SegmentOptions& o) {
                              std::to_string(source->skippedFrames() + refused) + " skipped)");
   }
   const std::filesystem::path dir(o.out);
-  {
-    OutputFile out = openOutput(dir / "source.txt");
-    out << absoluteSourceUri(o.source) << "\n";
-    out.commit();
-  }
-  {
-    OutputFile out = openOutput(dir / "frames.csv");
-    writeFramesCsv(out, run);
-    out.commit();
-  }
-  {
-    OutputFile out = openOutput(dir / "places.csv");
-    writePlacesCsv(out, run.places);
-    out.commit();
-  }
-  {
-    OutputFile out = openOutput(dir / "dropped_places.csv");
-    writePlacesCsv(out, run.dropped_places);
-    out.commit();
-  }
-  writeTimingCsv(dir / "timing.csv", timing);
-  {
-    OutputFile out = openOutput(dir / "lambda2.svg");
-    out << renderSvgLinePlot(lambda2Plot(run, config, "Fiedler value over " + o.source));
-    out.commit();
-  }
+  writeSources(dir, {absoluteSourceUri(o.source)});
+  writeFrames(dir, frameRows(run), FrameColumns::Segmentation);
+  writePlaces(dir, placeRows(run.places));
+  writeDroppedPlaces(dir, placeRows(run.dropped_places));
+  writeTiming(dir, timing);
+  writeLambda2Plot(dir, run, config, "Fiedler value over " + o.source);
 
   const TimingSummary f = summarize(fingerprint_ms);
   const TimingSummary s = summarize(segment_ms);

@@ -17,6 +17,7 @@
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "offline_run_io.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/sim/floor_plan.hpp"
 #include "toposlam/sim/map_drawing.hpp"
@@ -77,8 +78,8 @@ void runSim(const SimOptions& options) {
   if (error) throw std::runtime_error("--out: cannot create '" + (out / "frames").string() + "': " + error.message());
   // Every file goes through an OutputFile (temporary name, checked, renamed): a full disk is an error
   // naming the file (exit 1), never "wrote".
-  OutputFile labels(out / "labels.csv");
-  labels << "frame,time,room,x,y,heading,traversal\n";
+  OutputFile labels(out / run_files::kLabels);
+  labels << labelsHeader();
   // The frames' capture times, read back by images: sources (the segmentation window is in seconds).
   OutputFile timestamps(out / "frames" / "timestamps.csv");
   timestamps << "name,time_s\n";
@@ -99,11 +100,15 @@ void runSim(const SimOptions& options) {
     char name[32];
     std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(i));
     writeImageFile(out / "frames" / name, frame.image);
-    char row[192];
-    std::snprintf(row, sizeof row, "%lld,%.4f,%d,%.4f,%.4f,%.5f,%d\n", static_cast<long long>(i),
-                  frame.truth.time_s, frame.truth.room, frame.truth.pose.x, frame.truth.pose.y,
-                  frame.truth.pose.heading, frame.truth.traversal);
-    labels << row;
+    LabelRow label;
+    label.frame = i;
+    label.time_s = frame.truth.time_s;
+    label.room = frame.truth.room;
+    label.x = frame.truth.pose.x;
+    label.y = frame.truth.pose.y;
+    label.heading = frame.truth.pose.heading;
+    label.traversal = frame.truth.traversal;
+    labels << labelsRow(label);
     char stamp[64];
     std::snprintf(stamp, sizeof stamp, "%s,%.6f\n", name, frame.truth.time_s);
     timestamps << stamp;

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "offline_run_io.hpp"
-#include "toposlam/core/json_writer.hpp"
+#include "toposlam/run_folder/run_folder.hpp"
 
 namespace toposlam::cli {
 
@@ -69,71 +69,51 @@ void writeRunFolderFromLog(const LoggedRun& run, const std::string& log_path, co
       node[static_cast<std::size_t>(f)] = node_of_place[p.place];
     }
 
-  createRunFolder(dir.string());
-  {
-    OutputFile out = openOutput(dir / "frames.csv");
-    out << "frame,time,name,lambda2,place,node\n";
-    char line[160];
-    for (std::size_t i = 0; i < n; ++i) {
-      std::string l2;
-      if (!std::isnan(lambda2[i])) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%.6f", lambda2[i]);
-        l2 = text;
-      }
-      std::snprintf(line, sizeof line, "%zu,%.6f,%s,%s,%d,%d\n", i, time[i], frameName(static_cast<std::int64_t>(i)).c_str(),
-                    l2.c_str(), place[i], node[i]);
-      out << line;
-    }
-    out.commit();
+  createRunFolder(dir);
+  std::vector<FrameRecord> frames(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    frames[i].frame = static_cast<std::int64_t>(i);
+    frames[i].time_s = time[i];
+    frames[i].name = frameName(static_cast<std::int64_t>(i));
+    frames[i].lambda2 = lambda2[i];
+    frames[i].place = place[i];
+    frames[i].node = node[i];
   }
-  {
-    OutputFile out = openOutput(dir / "places.csv");
-    out << "place,first,last,representative,keypoints,node\n";
-    for (const LoggedPlace& p : run.places)
-      out << p.place << "," << p.first_frame << "," << p.last_frame << "," << p.representative_frame << ","
-          << p.keypoints << "," << node_of_place[p.place] << "\n";
-    out.commit();
+  writeFrames(dir, frames, FrameColumns::Segmentation);
+  std::vector<PlaceRecord> places;
+  for (const LoggedPlace& p : run.places)
+    places.push_back(PlaceRecord{p.place, 0, p.first_frame, p.last_frame, p.representative_frame, p.keypoints,
+                                 node_of_place[p.place]});
+  writePlaces(dir, places);
+  TopologyFile topology;
+  if (run.topology) {
+    topology.probability = run.topology->probability;
+    topology.particles = run.topology->particles;
+    for (const TopologyNode& t : run.topology->nodes)
+      topology.nodes.push_back(TopologyFile::Node{t.id, t.places, t.representative_frames, {}});
+    for (const TopologyEdge& e : run.topology->edges)
+      topology.edges.push_back(TopologyFile::Edge{e.from, e.to, e.count});
   }
-  {
-    OutputFile out = openOutput(dir / "topology.json");
-    JsonWriter json(out);
-    json.beginObject();
-    json.field("probability", run.topology ? run.topology->probability : 0.0);
-    json.field("particles", run.topology ? run.topology->particles : 0);
-    json.key("nodes").beginArray();
-    if (run.topology)
-      for (const TopologyNode& t : run.topology->nodes) {
-        json.beginObject().field("id", t.id).key("places").beginArray();
-        for (int p : t.places) json.value(p);
-        json.endArray().key("representative_frames").beginArray();
-        for (std::int64_t f : t.representative_frames) json.value(f);
-        json.endArray().endObject();
-      }
-    json.endArray().key("edges").beginArray();
-    if (run.topology)
-      for (const TopologyEdge& e : run.topology->edges)
-        json.beginObject().field("from", e.from).field("to", e.to).field("count", e.count).endObject();
-    json.endArray().key("history").beginArray();
-    for (const LoggedPlace& p : run.places)
-      json.beginObject().field("place", p.place).field("node", p.node).field("probability", p.probability)
-          .field("is_new", p.is_new).endObject();
-    json.endArray().endObject();
-    out << "\n";
-    out.commit();
+  for (const LoggedPlace& p : run.places) {
+    TopologyFile::Step& step = topology.history.emplace_back();
+    step.place = p.place;
+    step.node = p.node;
+    step.probability = p.probability;
+    step.is_new = p.is_new;
   }
+  writeTopology(dir, topology);
   // The representatives' thumbnails, named as frames.csv names their frames: the report shows them.
-  fs::create_directories(dir / "frames");
+  fs::create_directories(dir / run_files::kFramesFolder);
   for (const LoggedPlace& p : run.places) {
     if (p.thumbnail_jpeg.empty()) continue;
-    OutputFile out = openOutput(dir / "frames" / frameName(p.representative_frame));
+    OutputFile out = openOutput(dir / run_files::kFramesFolder / frameName(p.representative_frame));
     out.write(reinterpret_cast<const char*>(p.thumbnail_jpeg.data()), static_cast<std::streamsize>(p.thumbnail_jpeg.size()));
     out.commit();
   }
-  writeSettingsTxt(dir / "settings.txt", {{"source", "lcmlog:" + fs::absolute(log_path).string()},
-                                          {"log events", std::to_string(run.events)},
-                                          {"place estimates", std::to_string(run.frames.size())},
-                                          {"place events", std::to_string(run.places.size())}});
+  writeSettings(dir, {{"source", "lcmlog:" + fs::absolute(log_path).string()},
+                      {"log events", std::to_string(run.events)},
+                      {"place estimates", std::to_string(run.frames.size())},
+                      {"place events", std::to_string(run.places.size())}});
 }
 
 }  // namespace toposlam::cli

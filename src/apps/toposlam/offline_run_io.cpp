@@ -4,7 +4,6 @@
 
 #include <cstdio>
 #include <stdexcept>
-#include <system_error>
 #include <vector>
 
 #include "toposlam/io/image_codec.hpp"
@@ -28,38 +27,6 @@ void writeImageFile(const std::filesystem::path& path, const cv::Mat& image) {
   }
   OutputFile out(path);
   out.write(reinterpret_cast<const char*>(encoded.data()), static_cast<std::streamsize>(encoded.size()));
-  out.commit();
-}
-
-void createRunFolder(const std::string& dir) {
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (error || !std::filesystem::is_directory(dir)) {
-    throw std::runtime_error(dir + ": cannot create the output folder" +
-                             (error ? " (" + error.message() + ")" : std::string()));
-  }
-}
-
-void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTiming>& rows) {
-  OutputFile out = openOutput(path);
-  out << "frame,fingerprint_ms,segment_ms,filter_ms\n";
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    char line[112];
-    std::snprintf(line, sizeof(line), "%zu,%.4f,%.4f,", i, rows[i].fingerprint_ms, rows[i].segment_ms);
-    out << line;
-    if (rows[i].filter_ms) {
-      std::snprintf(line, sizeof(line), "%.4f", *rows[i].filter_ms);
-      out << line;
-    }
-    out << '\n';
-  }
-  out.commit();
-}
-
-void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::pair<std::string, std::string>>& settings) {
-  OutputFile out = openOutput(path);
-  out << "# what this run was made with (toposlam map); read by toposlam report\n";
-  for (const auto& [key, value] : settings) out << key << " = " << value << "\n";
   out.commit();
 }
 

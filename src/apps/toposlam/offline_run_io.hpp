@@ -1,6 +1,7 @@
-// Shared pieces of the offline commands that write a run folder (`segment`, `map`): opening the frame
-// source, creating output files with an actionable error, timing.csv, and the one block of
-// segmentation options both commands take (defaults from FiedlerSegmenterConfig).
+// Shared pieces of the offline commands (`segment`, `map`, and the other commands' output files): opening
+// the frame source, creating output files with an actionable error, and the one block of segmentation
+// options `segment` and `map` take (defaults from FiedlerSegmenterConfig). The run folder's files are
+// run_folder's (toposlam/run_folder/run_folder.hpp).
 #pragma once
 
 #include <filesystem>
@@ -36,22 +37,9 @@ OutputFile openOutput(const std::filesystem::path& path);
 /// when it is not, and a failed write leaves the old file in place.
 void writeImageFile(const std::filesystem::path& path, const cv::Mat& image);
 
-/// Creates the run folder; throws std::runtime_error naming it when it cannot.
-void createRunFolder(const std::string& dir);
-
 /// "COMMAND: the source's clock went back N times (the last by X s): ..." for a source whose timestamps
 /// stepped back (docs/reliability.md, "Clock jumps").
 std::string timelineSummary(const FrameTimeline& timeline, const std::string& command);
-
-/// One row of timing.csv, milliseconds.
-struct FrameTiming {
-  double fingerprint_ms = 0.0;
-  double segment_ms = 0.0;
-  std::optional<double> filter_ms;  ///< empty column when the command has no filter (`segment`)
-};
-void writeTimingCsv(const std::filesystem::path& path, const std::vector<FrameTiming>& rows);
-/// settings.txt of a run folder: what the run was made with, one "key = value" line each (docs/run-folder.md).
-void writeSettingsTxt(const std::filesystem::path& path, const std::vector<std::pair<std::string, std::string>>& settings);
 
 /// --preset plus --window-s, --window, --min-window-frames, --gamma, --delta, --similarity-floor,
 /// --min-keypoints, --cut: the preset gives every stage's defaults, an option given overrides its key.

@@ -232,8 +232,8 @@ int runDaemon(const DaemonConfig& config) {
 
   SystemdNotifier notifier;
   SteadyClock clock;
-  PipelineConfig pipeline_config = config.pipeline;
-  pipeline_config.map_path = resolveMapPath(config.pipeline.map_path);
+  MapConfig map_config = config.map;
+  map_config.path = resolveMapPath(config.map.path);
 
   Assembly parts(config, clock, config.source);
   RecordingFrameSource* recording = startRecording(config.record, parts.source);
@@ -242,11 +242,11 @@ int runDaemon(const DaemonConfig& config) {
   // One writer per map: a second daemon (or `toposlam map`) on the same file is refused here, before
   // anything is loaded or saved. Then the temporary files of saves a kill -9 interrupted are removed.
   std::optional<MapLock> map_lock;
-  if (!pipeline_config.map_path.empty()) {
-    map_lock = MapLock::acquire(pipeline_config.map_path);
-    if (const int orphans = MapStore::removeOrphanedTemporaries(pipeline_config.map_path); orphans > 0)
+  if (!map_config.path.empty()) {
+    map_lock = MapLock::acquire(map_config.path);
+    if (const int orphans = MapStore::removeOrphanedTemporaries(map_config.path); orphans > 0)
       spdlog::info("toposlamd: removed {} temporary file(s) of interrupted map saves beside {}", orphans,
-                   pipeline_config.map_path);
+                   map_config.path);
   }
   // What the map records (and saves) as made with: the fingerprint settings and this run's source.
   MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
@@ -254,11 +254,11 @@ int runDaemon(const DaemonConfig& config) {
   parts.topology->setMapSettings(map_settings);
   FrameSource& named_source = *parts.source;
   parts.topology->nameFramesWith([&named_source](std::int64_t sequence) { return named_source.frameName(sequence); });
-  if (config.map.load_at_start && !pipeline_config.map_path.empty()) {
+  if (config.map.load_at_start && !map_config.path.empty()) {
     // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
     // human under a timestamped name (never over an earlier one) and the robot starts from what is left.
     const auto max_bytes = static_cast<std::uint64_t>(config.map.max_mb * 1024.0 * 1024.0);
-    RecoveredMap recovered = MapStore::recover(pipeline_config.map_path, *parts.similarity, max_bytes);
+    RecoveredMap recovered = MapStore::recover(map_config.path, *parts.similarity, max_bytes);
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
       // Another source continues the map only when told to (map.resume_other_source); other fingerprint
@@ -284,7 +284,7 @@ int runDaemon(const DaemonConfig& config) {
                    recovered.problems.empty() ? "" : ", the newest file that loads");
       if (!other_source) continueSource(recorded_settings, config, *parts.source, *parts.topology);
     } else if (!recovered.problems.empty()) {
-      spdlog::error("toposlamd: no map file of {} loads; starting a new map", pipeline_config.map_path);
+      spdlog::error("toposlamd: no map file of {} loads; starting a new map", map_config.path);
     }
   }
 
@@ -304,9 +304,9 @@ int runDaemon(const DaemonConfig& config) {
   });
   LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_status);
 
-  Pipeline pipeline(pipeline_config, *parts.source, *parts.fingerprint, *parts.segmentation, *parts.topology, sink,
-                    clock);
-  if (pipeline_config.queues.overflow == QueueOverflow::Auto)
+  Pipeline pipeline(config.pipeline, map_config, config.watchdog, *parts.source, *parts.fingerprint,
+                    *parts.segmentation, *parts.topology, sink, clock);
+  if (config.pipeline.queues.overflow == QueueOverflow::Auto)
     spdlog::info("toposlamd: full queues {} (pipeline.queues.overflow auto: {})", toString(pipeline.overflow()),
                  pipeline.overflow() == QueueOverflow::Block
                      ? "the source waits for the pipeline, so every frame is processed"

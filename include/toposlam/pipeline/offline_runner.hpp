@@ -22,7 +22,7 @@
 
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/stages.hpp"
-#include "toposlam/segmentation/offline_segmentation.hpp"
+#include "toposlam/segmentation/segmentation_run.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -33,11 +33,11 @@ struct MappedPlace {
   TopologyEstimate estimate;
 };
 
-class OfflineMapper {
+class OfflineRunner {
  public:
-  /// The stages must outlive the mapper. `topology` may already hold observations (a resumed map); null:
+  /// The stages must outlive the runner. `topology` may already hold observations (a resumed map); null:
   /// segmentation only (`toposlam segment`), mapPlace() does nothing.
-  OfflineMapper(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
+  OfflineRunner(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
                 ParticleFilterTopologyStage* topology = nullptr);
 
   /// Starts the next traversal (a fresh segmentation window); the first one starts implicitly. An open

@@ -1,5 +1,5 @@
 // Recursive-descent JSON parser with line/column error messages (see json_reader.hpp).
-#include "toposlam/eval/json_reader.hpp"
+#include "toposlam/run_folder/json_reader.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-namespace toposlam::eval {
+namespace toposlam {
 
 JsonValue JsonValue::makeBool(bool b) {
   JsonValue v;
@@ -323,4 +323,4 @@ JsonValue readJsonFile(const std::string& path) {
   return parseJson(text.str(), path);
 }
 
-}  // namespace toposlam::eval
+}  // namespace toposlam

@@ -1,4 +1,4 @@
-// OfflineMapper (`toposlam map`'s runner of the daemon's stages) on hand-made similarities: two traversals (sources) of the
+// OfflineRunner (`toposlam map`'s runner of the daemon's stages) on hand-made similarities: two traversals (sources) of the
 // same three blocks. Checks the run numbering across traversals, one filter step per kept place, and
 // that the second traversal's places land on the first traversal's nodes.
 #include <catch2/catch.hpp>
@@ -8,13 +8,13 @@
 
 #include "segmentation/fake_similarity.hpp"
 #include "toposlam/pipeline/clock.hpp"
-#include "toposlam/pipeline/offline_mapper.hpp"
+#include "toposlam/pipeline/offline_runner.hpp"
 
 using namespace toposlam;
 using toposlam::test::fakeFingerprint;
 using toposlam::test::TableSimilarity;
 
-SCENARIO("OfflineMapper maps two traversals of three blocks onto three nodes", "[segmentation][mapper]") {
+SCENARIO("OfflineRunner maps two traversals of three blocks onto three nodes", "[segmentation][runner]") {
   GIVEN("two sources of 120 frames each, blocks of 40 frames that match their twin of the other source") {
     auto block = [](int frame) { return (frame % 120) / 40; };
     TableSimilarity similarity([&](int a, int b) {
@@ -25,24 +25,24 @@ SCENARIO("OfflineMapper maps two traversals of three blocks onto three nodes", "
     FiedlerSegmentationStage segmentation(test::thesisConfig(), similarity, 1);
     const ManualClock clock;
     ParticleFilterTopologyStage topology(TopologyFilterConfig{}, similarity, clock, TopologyStageConfig{});
-    OfflineMapper mapper(fingerprints, segmentation, &topology);
+    OfflineRunner runner(fingerprints, segmentation, &topology);
     std::vector<std::int64_t> closed_frames;
     for (int source = 0; source < 2; ++source) {
-      mapper.beginTraversal();
+      runner.beginTraversal();
       for (int i = 0; i < 120; ++i) {
-        const SegmenterStep step = mapper.segment(0.2 * i, "", fakeFingerprint(120 * source + i));
+        const SegmenterStep step = runner.segment(0.2 * i, "", fakeFingerprint(120 * source + i));
         CHECK(step.frame == 120 * source + i);
         if (step.closed_place) {
           closed_frames.push_back(step.closed_place->first_frame);
-          mapper.mapPlace(*step.closed_place);
+          runner.mapPlace(*step.closed_place);
         }
       }
-      if (auto last = mapper.finishTraversal()) {
+      if (auto last = runner.finishTraversal()) {
         closed_frames.push_back(last->first_frame);
-        mapper.mapPlace(*last);
+        runner.mapPlace(*last);
       }
     }
-    const SegmentationRun& run = mapper.run();
+    const SegmentationRun& run = runner.run();
     THEN("frames and places are numbered over both traversals, each traversal cut at its block borders") {
       REQUIRE(run.frames.size() == 240);
       CHECK(run.frames[239].frame == 239);
@@ -53,13 +53,13 @@ SCENARIO("OfflineMapper maps two traversals of three blocks onto three nodes", "
         CHECK(run.places[p].first_frame == static_cast<std::int64_t>(40 * p));
       }
       CHECK(run.frames[130].place == 3);
-      CHECK(mapper.traversals() == 2);
+      CHECK(runner.traversals() == 2);
     }
     THEN("one filter step per kept place, and the second traversal closes the loop onto the same nodes") {
-      REQUIRE(mapper.steps().size() == 6);
-      CHECK(mapper.steps()[3].place.first_frame == 120);
+      REQUIRE(runner.steps().size() == 6);
+      CHECK(runner.steps()[3].place.first_frame == 120);
       CHECK(topology.observations() == 6);
-      const std::vector<std::int64_t> nodes = mapper.placeNodes();
+      const std::vector<std::int64_t> nodes = runner.placeNodes();
       CHECK(nodes == std::vector<std::int64_t>{0, 1, 2, 0, 1, 2});
     }
   }

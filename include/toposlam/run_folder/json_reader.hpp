@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-namespace toposlam::eval {
+namespace toposlam {
 
 /// Thrown for malformed JSON or a value of the wrong type; what() names the source and position.
 class JsonError : public std::runtime_error {
@@ -65,4 +65,4 @@ JsonValue parseJson(std::string_view text, const std::string& source_name = "jso
 /// Reads and parses a file; throws JsonError naming the file when it cannot be read or parsed.
 JsonValue readJsonFile(const std::string& path);
 
-}  // namespace toposlam::eval
+}  // namespace toposlam

@@ -1,5 +1,5 @@
-// OfflineMapper: the stage adapters driven in order on one thread, and the run's frame and place rows.
-#include "toposlam/pipeline/offline_mapper.hpp"
+// OfflineRunner: the stage adapters driven in order on one thread, and the run's frame and place rows.
+#include "toposlam/pipeline/offline_runner.hpp"
 
 #include <cmath>
 #include <limits>
@@ -8,25 +8,25 @@
 
 namespace toposlam {
 
-OfflineMapper::OfflineMapper(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
+OfflineRunner::OfflineRunner(FingerprintStage& fingerprint, FiedlerSegmentationStage& segmentation,
                              ParticleFilterTopologyStage* topology)
     : fingerprint_(fingerprint),
       segmentation_(segmentation),
       topology_(topology),
       first_observation_(topology != nullptr ? topology->observations() : 0) {}
 
-void OfflineMapper::beginTraversal() {
+void OfflineRunner::beginTraversal() {
   if (open_) finish();
   segmentation_.beginTraversal();
   ++traversal_count_;
   open_ = true;
 }
 
-std::shared_ptr<const Fingerprint> OfflineMapper::fingerprint(const cv::Mat& image, const cv::Mat& grey) {
+std::shared_ptr<const Fingerprint> OfflineRunner::fingerprint(const cv::Mat& image, const cv::Mat& grey) {
   return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey));
 }
 
-SegmenterStep OfflineMapper::segment(double source_time_s, const std::string& name,
+SegmenterStep OfflineRunner::segment(double source_time_s, const std::string& name,
                                      std::shared_ptr<const Fingerprint> fingerprint) {
   if (!open_) beginTraversal();
   SegmentationFrameRecord row;
@@ -49,10 +49,10 @@ SegmenterStep OfflineMapper::segment(double source_time_s, const std::string& na
   return step;
 }
 
-std::optional<MappedPlace> OfflineMapper::mapPlace(const SegmentedPlace& place) {
+std::optional<MappedPlace> OfflineRunner::mapPlace(const SegmentedPlace& place) {
   if (place.dropped || topology_ == nullptr) return std::nullopt;
   if (!pending_ || pending_->place != place.index)
-    throw std::logic_error("OfflineMapper::mapPlace: not the kept place the segmentation closed last");
+    throw std::logic_error("OfflineRunner::mapPlace: not the kept place the segmentation closed last");
   topology_->enqueuePlace(*pending_);
   pending_.reset();
   while (!topology_->idle()) topology_->advance(std::numeric_limits<double>::infinity());
@@ -62,7 +62,7 @@ std::optional<MappedPlace> OfflineMapper::mapPlace(const SegmentedPlace& place) 
   return mapped;
 }
 
-std::optional<SegmentedPlace> OfflineMapper::finishTraversal() {
+std::optional<SegmentedPlace> OfflineRunner::finishTraversal() {
   if (!open_) return std::nullopt;
   open_ = false;
   pending_ = segmentation_.finish();
@@ -71,16 +71,16 @@ std::optional<SegmentedPlace> OfflineMapper::finishTraversal() {
   return last;
 }
 
-void OfflineMapper::process(const cv::Mat& image, double source_time_s, const std::string& name) {
+void OfflineRunner::process(const cv::Mat& image, double source_time_s, const std::string& name) {
   const SegmenterStep step = segment(source_time_s, name, fingerprint(image));
   if (step.closed_place) mapPlace(*step.closed_place);
 }
 
-void OfflineMapper::finish() {
+void OfflineRunner::finish() {
   if (std::optional<SegmentedPlace> last = finishTraversal()) mapPlace(*last);
 }
 
-void OfflineMapper::record(const SegmentedPlace& place) {
+void OfflineRunner::record(const SegmentedPlace& place) {
   const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, place.first_frame));
   const auto end = std::min(run_.frames.size(), static_cast<std::size_t>(place.last_frame + 1));
   for (std::size_t f = first; f < end; ++f) {
@@ -90,7 +90,7 @@ void OfflineMapper::record(const SegmentedPlace& place) {
   (place.dropped ? run_.dropped_places : run_.places).push_back(place);
 }
 
-std::vector<std::int64_t> OfflineMapper::placeNodes() const {
+std::vector<std::int64_t> OfflineRunner::placeNodes() const {
   std::vector<std::int64_t> nodes;
   if (topology_ == nullptr) return nodes;
   // The topology stage's snapshot (the one toposlamd publishes) lists each node's places by observation.

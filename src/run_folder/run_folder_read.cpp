@@ -1,16 +1,16 @@
-// Loaders for run-folder files and ground truth (see run_files.hpp). All errors name file and line.
-#include "toposlam/eval/run_files.hpp"
+// The run folder's readers (see run_folder.hpp). All errors name file and line.
+#include "toposlam/run_folder/run_folder.hpp"
 
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include "toposlam/run_folder/json_reader.hpp"
 
-#include "toposlam/eval/json_reader.hpp"
-#include "toposlam/io/image_file.hpp"
+namespace toposlam {
 
-namespace toposlam::eval {
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -241,8 +241,32 @@ TopologyFile loadTopology(const std::string& path) {
     topo.probability = root.at("probability").asNumber("probability");
     if (const JsonValue* p = root.find("particles"))
       topo.particles = static_cast<int>(p->asNumber("particles"));
+    // The filter's estimate at the end (`map`); each key is optional, as in a hand-made file.
+    if (const JsonValue* c = root.find("current_node")) {
+      TopologyFile::Estimate e;
+      e.current_node = static_cast<int>(c->asNumber("current_node"));
+      if (const JsonValue* v = root.find("current_node_probability"))
+        e.current_node_probability = v->asNumber("current_node_probability");
+      if (const JsonValue* v = root.find("effective_sample_size"))
+        e.effective_sample_size = v->asNumber("effective_sample_size");
+      if (const JsonValue* v = root.find("distinct_topologies"))
+        e.distinct_topologies = static_cast<int>(v->asNumber("distinct_topologies"));
+      if (const JsonValue* v = root.find("earlier_places"))
+        e.earlier_places = static_cast<int>(v->asNumber("earlier_places"));
+      if (const JsonValue* alternatives = root.find("alternatives")) {
+        for (const JsonValue& a : alternatives->asArray("alternatives")) {
+          TopologyFile::Alternative alternative;
+          alternative.probability = a.at("probability").asNumber("alternatives[].probability");
+          alternative.nodes = static_cast<int>(a.at("nodes").asNumber("alternatives[].nodes"));
+          alternative.first_difference =
+              static_cast<int>(a.at("first_difference").asNumber("alternatives[].first_difference"));
+          e.alternatives.push_back(alternative);
+        }
+      }
+      topo.estimate = std::move(e);
+    }
     for (const JsonValue& n : root.at("nodes").asArray("nodes")) {
-      TopologyNode node;
+      TopologyFile::Node node;
       node.id = static_cast<int>(n.at("id").asNumber("nodes[].id"));
       for (const JsonValue& p : n.at("places").asArray("nodes[].places")) {
         node.places.push_back(static_cast<int>(p.asNumber("nodes[].places[]")));
@@ -253,11 +277,15 @@ TopologyFile loadTopology(const std::string& path) {
               static_cast<std::int64_t>(f.asNumber("nodes[].representative_frames[]")));
         }
       }
+      if (const JsonValue* earlier = n.find("earlier_places")) {
+        for (const JsonValue& p : earlier->asArray("nodes[].earlier_places"))
+          node.earlier_places.push_back(static_cast<int>(p.asNumber("nodes[].earlier_places[]")));
+      }
       topo.nodes.push_back(std::move(node));
     }
     if (const JsonValue* edges = root.find("edges")) {
       for (const JsonValue& e : edges->asArray("edges")) {
-        TopologyEdge edge;
+        TopologyFile::Edge edge;
         edge.from = static_cast<int>(e.at("from").asNumber("edges[].from"));
         edge.to = static_cast<int>(e.at("to").asNumber("edges[].to"));
         if (const JsonValue* c = e.find("count")) edge.count = static_cast<int>(c->asNumber("edges[].count"));
@@ -266,7 +294,7 @@ TopologyFile loadTopology(const std::string& path) {
     }
     if (const JsonValue* history = root.find("history")) {
       for (const JsonValue& h : history->asArray("history")) {
-        TopologyStep step;
+        TopologyFile::Step step;
         step.place = static_cast<int>(h.at("place").asNumber("history[].place"));
         if (const JsonValue* v = h.find("node")) step.node = static_cast<int>(v->asNumber("history[].node"));
         if (const JsonValue* v = h.find("probability"))
@@ -277,6 +305,7 @@ TopologyFile loadTopology(const std::string& path) {
         if (const JsonValue* v = h.find("effective_sample_size")) {
           step.effective_sample_size = v->asNumber("history[].effective_sample_size");
         }
+        if (const JsonValue* v = h.find("is_new")) step.is_new = v->asBool("history[].is_new");
         topo.history.push_back(step);
       }
     }
@@ -297,53 +326,82 @@ std::vector<TimingRow> loadTiming(const std::string& path) {
     return std::isfinite(v) ? v : 0.0;
   };
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    rows.push_back(TimingRow{t.integer(r, frame), get(r, fp), get(r, seg), get(r, filt)});
+    TimingRow row{t.integer(r, frame), get(r, fp), get(r, seg), std::nullopt};
+    // `segment` has no filter: an empty column.
+    if (filt >= 0 && !t.rows[r][static_cast<std::size_t>(filt)].empty()) row.filter_ms = get(r, filt);
+    rows.push_back(row);
   }
   return rows;
 }
 
-LoopClosureMatrix loadLoopClosureImage(const std::string& path) {
-  cv::Mat image;
-  try {
-    image = readImageFileChecked(path, ImageColor::Grey);
-  } catch (const ImageReadError& e) {
-    std::string reason = e.what();  // "PATH: why"
-    if (reason.rfind(path + ": ", 0) == 0) reason.erase(0, path.size() + 2);
-    throw RunFileError(path + ": cannot read as an image (expected a BMP/PNG loop-closure matrix): " + reason);
+std::vector<std::string> loadSources(const fs::path& dir) {
+  std::vector<std::string> sources;
+  if (std::ifstream in(dir / run_files::kSources); in) {
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty()) sources.push_back(line);
   }
-  if (image.rows != image.cols) {
-    throw RunFileError(path + ": loop-closure matrix must be square, got " + std::to_string(image.cols) +
-                       "x" + std::to_string(image.rows));
+  return sources;
+}
+
+RunSettings loadSettings(const fs::path& dir) {
+  RunSettings settings;
+  if (std::ifstream in(dir / run_files::kSettings); in) {
+    int number = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++number;
+      if (line.empty() || line[0] == '#') continue;
+      const auto eq = line.find(" = ");
+      if (eq == std::string::npos)
+        throw RunFileError((dir / run_files::kSettings).string() + ":" + std::to_string(number) +
+                           ": expected 'key = value', got '" + line + "'");
+      settings.emplace_back(line.substr(0, eq), line.substr(eq + 3));
+    }
   }
-  LoopClosureMatrix m;
-  m.size = image.rows;
-  m.same.assign(static_cast<std::size_t>(m.size) * static_cast<std::size_t>(m.size), 0);
-  for (int i = 0; i < m.size; ++i) {
-    for (int j = 0; j < m.size; ++j) {
-      if (image.at<std::uint8_t>(i, j) != 0) {
-        m.same[static_cast<std::size_t>(i * m.size + j)] = 1;
-        m.same[static_cast<std::size_t>(j * m.size + i)] = 1;
+  return settings;
+}
+
+RunData loadRun(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw RunFileError(dir + ": not a run folder (no such directory)");
+  RunData run;
+  run.dir = dir;
+  const fs::path root(dir);
+  if (!fs::exists(root / run_files::kFrames)) {
+    throw RunFileError((root / run_files::kFrames).string() +
+                       ": missing; give a folder written by `toposlam segment` or `toposlam map`");
+  }
+  run.frames = loadFrames((root / run_files::kFrames).string());
+  {
+    std::ifstream header((root / run_files::kFrames).string());
+    std::string line;
+    std::getline(header, line);
+    run.has_frame_matches = (',' + line + ',').find(",match,") != std::string::npos;
+  }
+  const auto frame_count = static_cast<std::int64_t>(run.frames.size());
+  // Places must lie inside frames.csv (loadPlaces already checked 0 <= first <= representative <= last).
+  auto loadPlacesWithin = [&](const std::string& name) {
+    const std::string path = (root / name).string();
+    std::vector<PlaceRecord> places = loadPlaces(path);
+    for (const PlaceRecord& p : places) {
+      if (p.last >= frame_count) {
+        throw RunFileError(path + ":" + std::to_string(p.line) + ": place " + std::to_string(p.place) +
+                           " spans frames " + std::to_string(p.first) + ".." + std::to_string(p.last) +
+                           " but frames.csv has " + std::to_string(frame_count) +
+                           " frames (a damaged or mixed-up run folder)");
       }
     }
+    return places;
+  };
+  if (fs::exists(root / run_files::kPlaces)) run.places = loadPlacesWithin(run_files::kPlaces);
+  if (fs::exists(root / run_files::kDroppedPlaces)) run.dropped_places = loadPlacesWithin(run_files::kDroppedPlaces);
+  if (fs::exists(root / run_files::kTopology)) run.topology = loadTopology((root / run_files::kTopology).string());
+  if (fs::exists(root / run_files::kTiming)) run.timing = loadTiming((root / run_files::kTiming).string());
+  run.sources = loadSources(root);
+  run.settings = loadSettings(root);
+  run.traversal_starts.push_back(0);
+  for (std::size_t f = 1; f < run.frames.size(); ++f) {
+    if (run.frames[f].time_s < run.frames[f - 1].time_s)
+      run.traversal_starts.push_back(static_cast<std::int64_t>(f));
   }
-  return m;
+  return run;
 }
-
-std::vector<NamedPair> loadLoopClosurePairs(const std::string& path) {
-  const CsvTable t = readCsv(path);
-  if (t.header.size() < 2) throw RunFileError(path + ":1: expected two columns: query,matches");
-  std::vector<NamedPair> pairs;
-  for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    const std::string& query = t.rows[r][0];
-    if (query.empty()) throw RunFileError(where(t, r) + ": empty query name");
-    // The second column may itself hold several space-separated names; extra columns are more names.
-    for (std::size_t c = 1; c < t.rows[r].size(); ++c) {
-      std::istringstream names(t.rows[r][c]);
-      std::string name;
-      while (names >> name) pairs.push_back(NamedPair{query, name, t.lines[r]});
-    }
-  }
-  return pairs;
-}
-
-}  // namespace toposlam::eval
+}  // namespace toposlam
