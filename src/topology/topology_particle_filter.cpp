@@ -40,6 +40,20 @@ double entropyFromSums(double sum, double sum_l_log_l, int n) {
 
 double lLogL(double l) { return l > 0.0 ? l * std::log(l) : 0.0; }
 
+/// lLogL that remembers its last argument: on an indexed step most nodes have the one background
+/// likelihood, so the logarithm is taken once for all of them (same value, bit for bit).
+struct LLogLMemo {
+  double l = std::numeric_limits<double>::quiet_NaN();
+  double l_log_l = 0.0;
+  double operator()(double value) {
+    if (value != l) {
+      l = value;
+      l_log_l = lLogL(value);
+    }
+    return l_log_l;
+  }
+};
+
 double entryLikelihood(const NodeEntry& entry, const std::vector<double>& similarity) {
   double best = 0.0;
   for (int r = 0; r < entry.representative_count; ++r) {
@@ -65,7 +79,8 @@ void markReferenced(const TrieNode* node, int level, std::uint64_t stamp,
 }
 
 /// Sums of node likelihoods below `node`, memoised per stamp (shared subtrees are summed once).
-void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::vector<double>& similarity) {
+void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::vector<double>& similarity,
+               LLogLMemo& l_log_l) {
   if (node->memo_stamp == stamp) return;
   double sum = 0.0, sum_l_log_l = 0.0, max = 0.0;
   if (level == 0) {
@@ -73,13 +88,13 @@ void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::
       if (entry.first_observation < 0) continue;
       const double l = entryLikelihood(entry, similarity);
       sum += l;
-      sum_l_log_l += lLogL(l);
+      sum_l_log_l += l_log_l(l);
       max = std::max(max, l);
     }
   } else {
     for (const auto& child : static_cast<const TrieBranch*>(node)->children) {
       if (!child) continue;
-      aggregate(child.get(), level - 1, stamp, similarity);
+      aggregate(child.get(), level - 1, stamp, similarity, l_log_l);
       sum += child->memo_sum;
       sum_l_log_l += child->memo_sum_l_log_l;
       max = std::max(max, child->memo_max);
@@ -220,10 +235,17 @@ void TopologyParticleFilter::relativeLikelihoods() {
   }
   sum_sq += background_extra_sq_;  // 0 unless indexed: the spread the background values stand for
   const int others = static_cast<int>(needed_list_.size()) - 1;
+  // On an indexed step most values are the background's one: the same input gives the same likelihood,
+  // so it is computed once for them (an exp per stored representative otherwise).
+  double last_in = std::numeric_limits<double>::quiet_NaN(), last_out = 0.0;
   for (const std::int32_t o : needed_list_) {
     double& s = similarity_of_[idx(o)];
-    s = relativeLikelihood(s, sum - s, sum_sq - s * s, others, config_.relative_slope, config_.relative_offset,
-                           config_.relative_sigma_floor);
+    if (s != last_in) {
+      last_in = s;
+      last_out = relativeLikelihood(s, sum - s, sum_sq - s * s, others, config_.relative_slope,
+                                    config_.relative_offset, config_.relative_sigma_floor);
+    }
+    s = last_out;
   }
 }
 
@@ -266,6 +288,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
   if (budget == 0) throw std::invalid_argument("TopologyParticleFilter::advance: budget must be >= 1");
   std::size_t used = 0;
   const std::size_t m = particles_.size();
+  LLogLMemo l_log_l_memo;
   while (phase_ != Phase::Idle) {
     switch (phase_) {
       case Phase::Collect:
@@ -306,7 +329,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           const TopologyState& g = *groups_[cursor_];
           GroupStats& stats = group_stats_[cursor_];
           if (g.nodeCount() == 0) continue;  // first observation: nothing known
-          aggregate(g.nodes.root().get(), g.nodes.levels(), stamp_, similarity_of_);
+          aggregate(g.nodes.root().get(), g.nodes.levels(), stamp_, similarity_of_, l_log_l_memo);
           const TrieNode& root = *g.nodes.root();
           stats.max = root.memo_max;
           stats.new_likelihood =
@@ -414,15 +437,21 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
 
 void TopologyParticleFilter::selectComparisons() {
   // needed_ marks: 1 = stored, 2 = compared (candidate or not indexable), 3 = compared (background sample).
-  compared_list_ = needed_list_;
   indexed_step_ = false;
   background_extra_sq_ = 0.0;
   const CandidateSelectionConfig& c = config_.candidates;
-  if (needed_list_.size() <= idx(c.exhaustive_up_to) || !PlaceCandidateIndex::supports(*pending_)) return;
+  if (needed_list_.size() <= idx(c.exhaustive_up_to) || !PlaceCandidateIndex::supports(*pending_)) {
+    compared_list_ = needed_list_;
+    return;
+  }
   if (!index_) {
     index_ = std::make_unique<PlaceCandidateIndex>(c.index);
-    for (std::size_t o = 0; o < fingerprints_.size(); ++o)
-      if (fingerprints_[o]) index_->add(static_cast<int>(o), *fingerprints_[o]);
+    indexable_.assign(fingerprints_.size(), 0);
+    for (std::size_t o = 0; o < fingerprints_.size(); ++o) {
+      if (!fingerprints_[o]) continue;
+      index_->add(static_cast<int>(o), *fingerprints_[o]);
+      indexable_[o] = PlaceCandidateIndex::supports(*fingerprints_[o]) ? 1 : 0;
+    }
   }
   indexed_step_ = true;
   ++indexed_steps_;
@@ -438,7 +467,7 @@ void TopologyParticleFilter::selectComparisons() {
   std::size_t rest = 0;
   for (const std::int32_t o : needed_list_) {
     if (needed_[idx(o)] != 1) continue;
-    if (PlaceCandidateIndex::supports(*fingerprints_[idx(o)])) {
+    if (indexable_[idx(o)]) {
       ++rest;
     } else {
       needed_[idx(o)] = 2;  // the index cannot hold it: always compared
@@ -504,7 +533,10 @@ void TopologyParticleFilter::setCandidateSelection(const CandidateSelectionConfi
 }
 
 void TopologyParticleFilter::finishStep() {
-  if (index_) index_->add(observation_count_, *pending_);
+  if (index_) {
+    index_->add(observation_count_, *pending_);
+    indexable_.push_back(PlaceCandidateIndex::supports(*pending_) ? 1 : 0);
+  }
   particles_.swap(next_particles_);
   next_particles_.clear();
   children_.clear();

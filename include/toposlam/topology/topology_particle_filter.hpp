@@ -292,6 +292,9 @@ class TopologyParticleFilter {
   double background_extra_sq_ = 0.0;  ///< sum of squared deviations the background values stand for
   std::int64_t indexed_steps_ = 0;
   std::unique_ptr<PlaceCandidateIndex> index_;  ///< holds the stored representatives once built
+  /// Per observation, while index_ exists: PlaceCandidateIndex::supports() of its fingerprint (asked once,
+  /// not per step: reading every stored fingerprint each step is a cache miss per place).
+  std::vector<unsigned char> indexable_;
   struct GroupStats {
     double max = 0.0;
     double new_likelihood = 1.0;
