@@ -16,7 +16,8 @@
 // process's (VmRSS) at each checkpoint; "compared" is the mean number of exact similarity evaluations per
 // step; "cmp ms" is the median time of a step spent in those evaluations (a timing wrapper around the
 // similarity) and "rest ms" the median of the rest of the step (the filter's own work). Prints numbers (and
-// an SVG with --svg), fails nothing.
+// an SVG with --svg), fails nothing. "est ms" is one TopologyParticleFilter::estimate(4) at the checkpoint,
+// not part of the step (the pipeline calls it after each step).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,6 +27,7 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -144,6 +146,7 @@ struct Checkpoint {
   TimingSummary step;
   TimingSummary compare;  ///< ms of a step spent in the exact comparisons
   TimingSummary rest;     ///< ms of a step spent elsewhere (the filter's bookkeeping)
+  double estimate_ms = 0;  ///< one TopologyParticleFilter::estimate(4) at the checkpoint (what a user reads after a step)
   double rss_mb = 0, index_mb = 0;
   double comparisons = 0;  ///< exact similarity evaluations per step, mean over the window
   int compared = 0, agreed = 0;
@@ -202,11 +205,11 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   if (!o.json)
     std::printf("map-size: %d steps, %d particles, %zu donor frames of %s; exhaustive up to %d stored, then %d "
                 "candidates + %d background samples; decisions compared every %d steps\n%8s %8s %10s %10s %10s "
-                "%8s %9s %9s %14s %14s %8s %8s\n",
+                "%8s %9s %9s %14s %14s %8s %8s %8s\n",
                 o.places, o.particles, donors.size(), o.samples.c_str(), o.candidates.exhaustive_up_to,
                 o.candidates.candidates, o.candidates.background_samples, o.compare_every, "steps", "stored",
                 "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "compared", "same decision", "when p >= 0.5",
-                "cmp ms", "rest ms");
+                "cmp ms", "rest ms", "est ms");
   for (int k = 0; k < o.places; ++k) {
     const auto observation = observationOf(prototype(route[static_cast<std::size_t>(k)]), rng);
     std::unique_ptr<TopologyParticleFilter> shadow;
@@ -273,6 +276,12 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       c.steps = k + 1;
       c.stored = filter.memoryStats().stored_fingerprints;
       c.step = summarize(window_ms);
+      {
+        Stopwatch estimate_watch;
+        const TopologyEstimate e = filter.estimate(4);
+        c.estimate_ms = estimate_watch.elapsedMs();
+        if (e.observations != k + 1) throw std::logic_error("bench map-size: estimate out of step");
+      }
       c.compare = summarize(window_compare_ms);
       c.rest = summarize(window_rest_ms);
       window_compare_ms.clear();
@@ -289,9 +298,10 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       window_ms.clear();
       window_compared = window_agreed = window_confident = window_confident_agreed = 0;
       if (!o.json) {
-        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %9.0f %8d of %3d %8d of %3d %8.2f %8.2f\n", c.steps,
+        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %9.0f %8d of %3d %8d of %3d %8.2f %8.2f %8.2f\n", c.steps,
                     c.stored, c.step.median_ms, c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.comparisons,
-                    c.agreed, c.compared, c.confident_agreed, c.confident, c.compare.median_ms, c.rest.median_ms);
+                    c.agreed, c.compared, c.confident_agreed, c.confident, c.compare.median_ms, c.rest.median_ms,
+                    c.estimate_ms);
         std::fflush(stdout);
       }
     }
@@ -314,6 +324,7 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       json.field("steps", c.steps).field("stored", c.stored).field("median_ms", c.step.median_ms);
       json.field("p99_ms", c.step.p99_ms).field("max_ms", c.step.max_ms).field("rss_mb", c.rss_mb);
       json.field("compare_median_ms", c.compare.median_ms).field("rest_median_ms", c.rest.median_ms);
+      json.field("estimate_ms", c.estimate_ms);
       json.field("index_mb", c.index_mb).field("comparisons_per_step", c.comparisons).field("compared", c.compared).field("same", c.agreed);
       json.field("confident", c.confident).field("confident_same", c.confident_agreed);
       json.endObject();
