@@ -40,6 +40,20 @@ double entropyFromSums(double sum, double sum_l_log_l, int n) {
 
 double lLogL(double l) { return l > 0.0 ? l * std::log(l) : 0.0; }
 
+/// lLogL that remembers its last argument: on an indexed step most nodes have the one background
+/// likelihood, so the logarithm is taken once for all of them (same value, bit for bit).
+struct LLogLMemo {
+  double l = std::numeric_limits<double>::quiet_NaN();
+  double l_log_l = 0.0;
+  double operator()(double value) {
+    if (value != l) {
+      l = value;
+      l_log_l = lLogL(value);
+    }
+    return l_log_l;
+  }
+};
+
 double entryLikelihood(const NodeEntry& entry, const std::vector<double>& similarity) {
   double best = 0.0;
   for (int r = 0; r < entry.representative_count; ++r) {
@@ -65,7 +79,8 @@ void markReferenced(const TrieNode* node, int level, std::uint64_t stamp,
 }
 
 /// Sums of node likelihoods below `node`, memoised per stamp (shared subtrees are summed once).
-void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::vector<double>& similarity) {
+void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::vector<double>& similarity,
+               LLogLMemo& l_log_l) {
   if (node->memo_stamp == stamp) return;
   double sum = 0.0, sum_l_log_l = 0.0, max = 0.0;
   if (level == 0) {
@@ -73,13 +88,13 @@ void aggregate(const TrieNode* node, int level, std::uint64_t stamp, const std::
       if (entry.first_observation < 0) continue;
       const double l = entryLikelihood(entry, similarity);
       sum += l;
-      sum_l_log_l += lLogL(l);
+      sum_l_log_l += l_log_l(l);
       max = std::max(max, l);
     }
   } else {
     for (const auto& child : static_cast<const TrieBranch*>(node)->children) {
       if (!child) continue;
-      aggregate(child.get(), level - 1, stamp, similarity);
+      aggregate(child.get(), level - 1, stamp, similarity, l_log_l);
       sum += child->memo_sum;
       sum_l_log_l += child->memo_sum_l_log_l;
       max = std::max(max, child->memo_max);
@@ -220,10 +235,17 @@ void TopologyParticleFilter::relativeLikelihoods() {
   }
   sum_sq += background_extra_sq_;  // 0 unless indexed: the spread the background values stand for
   const int others = static_cast<int>(needed_list_.size()) - 1;
+  // On an indexed step most values are the background's one: the same input gives the same likelihood,
+  // so it is computed once for them (an exp per stored representative otherwise).
+  double last_in = std::numeric_limits<double>::quiet_NaN(), last_out = 0.0;
   for (const std::int32_t o : needed_list_) {
     double& s = similarity_of_[idx(o)];
-    s = relativeLikelihood(s, sum - s, sum_sq - s * s, others, config_.relative_slope, config_.relative_offset,
-                           config_.relative_sigma_floor);
+    if (s != last_in) {
+      last_in = s;
+      last_out = relativeLikelihood(s, sum - s, sum_sq - s * s, others, config_.relative_slope,
+                                    config_.relative_offset, config_.relative_sigma_floor);
+    }
+    s = last_out;
   }
 }
 
@@ -266,6 +288,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
   if (budget == 0) throw std::invalid_argument("TopologyParticleFilter::advance: budget must be >= 1");
   std::size_t used = 0;
   const std::size_t m = particles_.size();
+  LLogLMemo l_log_l_memo;
   while (phase_ != Phase::Idle) {
     switch (phase_) {
       case Phase::Collect:
@@ -306,7 +329,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           const TopologyState& g = *groups_[cursor_];
           GroupStats& stats = group_stats_[cursor_];
           if (g.nodeCount() == 0) continue;  // first observation: nothing known
-          aggregate(g.nodes.root().get(), g.nodes.levels(), stamp_, similarity_of_);
+          aggregate(g.nodes.root().get(), g.nodes.levels(), stamp_, similarity_of_, l_log_l_memo);
           const TrieNode& root = *g.nodes.root();
           stats.max = root.memo_max;
           stats.new_likelihood =
@@ -414,15 +437,21 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
 
 void TopologyParticleFilter::selectComparisons() {
   // needed_ marks: 1 = stored, 2 = compared (candidate or not indexable), 3 = compared (background sample).
-  compared_list_ = needed_list_;
   indexed_step_ = false;
   background_extra_sq_ = 0.0;
   const CandidateSelectionConfig& c = config_.candidates;
-  if (needed_list_.size() <= idx(c.exhaustive_up_to) || !PlaceCandidateIndex::supports(*pending_)) return;
+  if (needed_list_.size() <= idx(c.exhaustive_up_to) || !PlaceCandidateIndex::supports(*pending_)) {
+    compared_list_ = needed_list_;
+    return;
+  }
   if (!index_) {
     index_ = std::make_unique<PlaceCandidateIndex>(c.index);
-    for (std::size_t o = 0; o < fingerprints_.size(); ++o)
-      if (fingerprints_[o]) index_->add(static_cast<int>(o), *fingerprints_[o]);
+    indexable_.assign(fingerprints_.size(), 0);
+    for (std::size_t o = 0; o < fingerprints_.size(); ++o) {
+      if (!fingerprints_[o]) continue;
+      index_->add(static_cast<int>(o), *fingerprints_[o]);
+      indexable_[o] = PlaceCandidateIndex::supports(*fingerprints_[o]) ? 1 : 0;
+    }
   }
   indexed_step_ = true;
   ++indexed_steps_;
@@ -438,7 +467,7 @@ void TopologyParticleFilter::selectComparisons() {
   std::size_t rest = 0;
   for (const std::int32_t o : needed_list_) {
     if (needed_[idx(o)] != 1) continue;
-    if (PlaceCandidateIndex::supports(*fingerprints_[idx(o)])) {
+    if (indexable_[idx(o)]) {
       ++rest;
     } else {
       needed_[idx(o)] = 2;  // the index cannot hold it: always compared
@@ -504,7 +533,10 @@ void TopologyParticleFilter::setCandidateSelection(const CandidateSelectionConfi
 }
 
 void TopologyParticleFilter::finishStep() {
-  if (index_) index_->add(observation_count_, *pending_);
+  if (index_) {
+    index_->add(observation_count_, *pending_);
+    indexable_.push_back(PlaceCandidateIndex::supports(*pending_) ? 1 : 0);
+  }
   particles_.swap(next_particles_);
   next_particles_.clear();
   children_.clear();
@@ -559,16 +591,42 @@ TopologyEstimate TopologyParticleFilter::estimate(int alternatives) const {
 
   auto describe = [&](std::size_t s) {
     TopologyHypothesis h;
-    h.assignment = assignmentOf(*states[s]);
     h.probability = counts[s] / m;
     h.node_count = states[s]->nodeCount();
     h.current_node = states[s]->currentNode();
     return h;
   };
+  // The best topology's assignment: only the records since the one the memo (the last estimate's best)
+  // shares with it are walked, usually the last step's. Walking all of them, one heap record per
+  // observation, took milliseconds at 10,000 places.
+  {
+    std::vector<const HistoryRecord*> suffix;
+    const HistoryRecord* r = states[order[0]]->record.get();
+    for (; r && !(idx(r->observation) < estimate_records_.size() && estimate_records_[idx(r->observation)] == r);
+         r = r->parent.get())
+      suffix.push_back(r);
+    const std::size_t shared = r ? idx(r->observation) + 1 : 0;
+    estimate_records_.resize(shared);
+    estimate_assignment_.resize(shared);
+    for (auto it = suffix.rbegin(); it != suffix.rend(); ++it) {
+      estimate_records_.push_back(*it);
+      estimate_assignment_.push_back((*it)->node);
+    }
+    for (const auto& p : particles_)  // a shared_ptr of that state keeps the memo's records alive
+      if (p.get() == states[order[0]]) estimate_state_ = p;
+  }
   out.best = describe(order[0]);
+  out.best.assignment = estimate_assignment_;
   for (std::size_t k = 1; k < order.size() && static_cast<int>(k) <= alternatives; ++k) {
     TopologyHypothesis h = describe(order[k]);
-    for (std::size_t o = 0; o < h.assignment.size(); ++o) {
+    // Its records since the last one it shares with the best topology; before that it is the best's.
+    std::vector<const HistoryRecord*> suffix;
+    const HistoryRecord* r = states[order[k]]->record.get();
+    for (; r && estimate_records_[idx(r->observation)] != r; r = r->parent.get()) suffix.push_back(r);
+    const std::size_t shared = r ? idx(r->observation) + 1 : 0;
+    h.assignment.assign(estimate_assignment_.begin(), estimate_assignment_.begin() + static_cast<std::ptrdiff_t>(shared));
+    for (auto it = suffix.rbegin(); it != suffix.rend(); ++it) h.assignment.push_back((*it)->node);
+    for (std::size_t o = shared; o < h.assignment.size(); ++o) {
       if (h.assignment[o] != out.best.assignment[o]) {
         h.first_difference = static_cast<int>(o);
         break;
@@ -581,8 +639,13 @@ TopologyEstimate TopologyParticleFilter::estimate(int alternatives) const {
 
   // Current-node hypotheses, identified by the first observation of the node.
   const TopologyState& best = *states[order[0]];
-  std::unordered_map<int, int> best_node_of_founder;
-  for (int n = 0; n < best.nodeCount(); ++n) best_node_of_founder[best.nodes.get(n).first_observation] = n;
+  // The best topology's node founded at observation `founder`, if any: the node it assigned that
+  // observation to, when that node's first observation it is.
+  const auto bestNodeOf = [&](int founder) {
+    if (founder < 0 || idx(founder) >= out.best.assignment.size()) return -1;
+    const int n = out.best.assignment[idx(founder)];
+    return best.nodes.get(n).first_observation == founder ? n : -1;
+  };
   std::vector<LocationHypothesis> locations;
   std::unordered_map<int, std::size_t> location_index;
   for (std::size_t s = 0; s < states.size(); ++s) {
@@ -591,8 +654,7 @@ TopologyEstimate TopologyParticleFilter::estimate(int alternatives) const {
     if (inserted) {
       LocationHypothesis l;
       l.founding_observation = founder;
-      auto b = best_node_of_founder.find(founder);
-      l.node_in_best = b == best_node_of_founder.end() ? -1 : b->second;
+      l.node_in_best = bestNodeOf(founder);
       locations.push_back(l);
     }
     locations[it->second].probability += counts[s] / m;

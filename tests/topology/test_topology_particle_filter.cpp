@@ -384,3 +384,57 @@ TEST_CASE("GIVEN evidence from outside the representatives WHEN a step takes it 
   filter.step(test::taggedFingerprint(1), odd);
   CHECK(filter.observationCount() == 2);
 }
+
+TEST_CASE(
+    "GIVEN estimate() called after every step (its memo of the last best topology warm) WHEN compared with the "
+    "estimate of a loaded copy (no memo) and with the particles' own assignments THEN they are identical",
+    "[topology]") {
+  // Look-alike places (same tag modulo 3): the best topology changes lineage now and then.
+  auto sim = TagSimilarity([](int a, int b) { return a == b ? 0.8 : (a % 3 == b % 3 ? 0.6 : 0.1); });
+  TopologyParticleFilter warm(configWith(200, 5), sim);
+  const std::vector<int> places = route(7, 3);
+  int alternatives_checked = 0, best_changed_lineage = 0;
+  std::vector<int> previous_best;
+  for (const int place : places) {
+    warm.step(taggedFingerprint(place));
+    const TopologyEstimate e = warm.estimate(4);
+    std::istringstream in(stateBytes(warm));
+    const auto cold = TopologyParticleFilter::loadState(in, sim);
+    const TopologyEstimate c = cold->estimate(4);
+    REQUIRE(e.best.assignment == c.best.assignment);
+    REQUIRE(e.best.probability == c.best.probability);
+    REQUIRE(e.alternatives.size() == c.alternatives.size());
+    for (std::size_t k = 0; k < e.alternatives.size(); ++k) {
+      REQUIRE(e.alternatives[k].assignment == c.alternatives[k].assignment);
+      REQUIRE(e.alternatives[k].first_difference == c.alternatives[k].first_difference);
+      REQUIRE(e.alternatives[k].probability == c.alternatives[k].probability);
+    }
+    REQUIRE(e.locations.size() == c.locations.size());
+    // Every topology reported is some particle's, in full; the first difference is the first index where it
+    // differs from the best; a location's node in the best topology is the node first seen there.
+    std::vector<std::vector<int>> held;
+    for (int i = 0; i < warm.config().particles; ++i) held.push_back(warm.particleAssignment(i));
+    REQUIRE(std::find(held.begin(), held.end(), e.best.assignment) != held.end());
+    for (const TopologyHypothesis& h : e.alternatives) {
+      REQUIRE(std::find(held.begin(), held.end(), h.assignment) != held.end());
+      const auto diff = std::mismatch(h.assignment.begin(), h.assignment.end(), e.best.assignment.begin());
+      REQUIRE(h.first_difference == (diff.first == h.assignment.end() ? -1 : static_cast<int>(diff.first - h.assignment.begin())));
+      ++alternatives_checked;
+    }
+    for (std::size_t k = 0; k < e.locations.size(); ++k) {
+      const LocationHypothesis& l = e.locations[k];
+      REQUIRE(l.founding_observation == c.locations[k].founding_observation);
+      REQUIRE(l.node_in_best == c.locations[k].node_in_best);
+      const auto& a = e.best.assignment;
+      const int node = a[static_cast<std::size_t>(l.founding_observation)];
+      const bool founded_there = std::find(a.begin(), a.end(), node) - a.begin() == l.founding_observation;
+      REQUIRE(l.node_in_best == (founded_there ? node : -1));
+    }
+    if (!previous_best.empty() &&
+        !std::equal(previous_best.begin(), previous_best.end(), e.best.assignment.begin()))
+      ++best_changed_lineage;
+    previous_best = e.best.assignment;
+  }
+  CHECK(alternatives_checked > 20);
+  CHECK(best_changed_lineage > 0);  // the memo's shared prefix was not always the whole last best
+}

@@ -62,6 +62,8 @@ class PlaceCandidateIndex {
  private:
   /// The key of descriptor row `row` in table `table`, or false when the row is too short.
   bool keyOf(const std::uint8_t* row, int row_bytes, int table, std::uint32_t& key) const;
+  /// keys_ := the bucket (table << bits | key) of every descriptor row and table, rows first.
+  void bucketsOf(const Fingerprint& fingerprint);
 
   PlaceCandidateIndexConfig config_;
   std::vector<std::uint16_t> bit_positions_;           ///< tables x bits_per_key
@@ -72,6 +74,7 @@ class PlaceCandidateIndex {
   // Query scratch.
   std::vector<std::uint32_t> votes_;
   std::vector<std::uint32_t> touched_;
+  std::vector<std::uint32_t> keys_;  ///< bucketsOf()'s result (add() and candidates())
 };
 
 }  // namespace toposlam

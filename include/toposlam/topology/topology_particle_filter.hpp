@@ -216,7 +216,9 @@ class TopologyParticleFilter {
 
   const TopologyFilterConfig& config() const { return config_; }
   int observationCount() const { return observation_count_; }  ///< completed steps
-  /// Summary of the current particles (call between steps). O(M + history x alternatives).
+  /// Summary of the current particles (call between steps). O(M log M + history): the best topology's
+  /// assignment is copied out whole, but only the history records since the last call's best topology
+  /// and, per alternative, those since it left the best are walked.
   TopologyEstimate estimate(int alternatives = 4) const;
   /// Assignment sequence of particle i (for tests).
   std::vector<int> particleAssignment(int i) const;
@@ -292,6 +294,9 @@ class TopologyParticleFilter {
   double background_extra_sq_ = 0.0;  ///< sum of squared deviations the background values stand for
   std::int64_t indexed_steps_ = 0;
   std::unique_ptr<PlaceCandidateIndex> index_;  ///< holds the stored representatives once built
+  /// Per observation, while index_ exists: PlaceCandidateIndex::supports() of its fingerprint (asked once,
+  /// not per step: reading every stored fingerprint each step is a cache miss per place).
+  std::vector<unsigned char> indexable_;
   struct GroupStats {
     double max = 0.0;
     double new_likelihood = 1.0;
@@ -303,6 +308,12 @@ class TopologyParticleFilter {
   std::vector<StatePtr> next_particles_;
   std::unordered_map<std::uint64_t, std::int32_t> child_index_;  ///< (group, node) -> child
   std::vector<StatePtr> children_;
+
+  // estimate()'s memo (mutable: a cache, the filter is single-threaded): the last best topology, its
+  // history record and node per observation. The next best shares all but its last records with it.
+  mutable StatePtr estimate_state_;  ///< keeps the records below alive (so no address is reused)
+  mutable std::vector<const topology_detail::HistoryRecord*> estimate_records_;
+  mutable std::vector<int> estimate_assignment_;
 };
 
 }  // namespace toposlam

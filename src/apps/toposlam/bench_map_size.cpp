@@ -14,8 +14,12 @@
 // current node over the particles) is compared with the indexed step's, over all compared steps and over
 // those where the exhaustive filter has decided (its most probable node has p >= 0.5). Timings are the indexed filter's steps only; RSS is the
 // process's (VmRSS) at each checkpoint; "compared" is the mean number of exact similarity evaluations per
-// step. Prints numbers (and an SVG with --svg), fails nothing.
+// step; "cmp ms" is the median time of a step spent in those evaluations (a timing wrapper around the
+// similarity) and "rest ms" the median of the rest of the step (the filter's own work). Prints numbers (and
+// an SVG with --svg), fails nothing. "est ms" is one TopologyParticleFilter::estimate(4) at the checkpoint,
+// not part of the step (the pipeline calls it after each step).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +27,7 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -72,6 +77,29 @@ class NudgedSimilarity final : public SimilarityMeasure {
   const SimilarityMeasure& inner_;
 };
 
+/// The filter's similarity, timed: how much of a step the exact comparisons take (the rest is the
+/// filter's own bookkeeping, which must not grow with the map).
+class TimedSimilarity final : public SimilarityMeasure {
+ public:
+  explicit TimedSimilarity(const SimilarityMeasure& inner) : inner_(inner) {}
+  double similarity(const Fingerprint& reference, const Fingerprint& query) const override {
+    const auto start = std::chrono::steady_clock::now();
+    const double s = inner_.similarity(reference, query);
+    elapsed_ += std::chrono::steady_clock::now() - start;
+    return s;
+  }
+  /// ms spent in similarity() since the last call.
+  double takeMs() const {
+    const double ms = std::chrono::duration<double, std::milli>(elapsed_).count();
+    elapsed_ = {};
+    return ms;
+  }
+
+ private:
+  const SimilarityMeasure& inner_;
+  mutable std::chrono::steady_clock::duration elapsed_{};
+};
+
 double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 void flipBits(cv::Mat& descriptors, int row, double probability, std::mt19937_64& rng) {
@@ -116,6 +144,9 @@ struct Checkpoint {
   int steps = 0;
   std::size_t stored = 0;
   TimingSummary step;
+  TimingSummary compare;  ///< ms of a step spent in the exact comparisons
+  TimingSummary rest;     ///< ms of a step spent elsewhere (the filter's bookkeeping)
+  double estimate_ms = 0;  ///< one TopologyParticleFilter::estimate(4) at the checkpoint (what a user reads after a step)
   double rss_mb = 0, index_mb = 0;
   double comparisons = 0;  ///< exact similarity evaluations per step, mean over the window
   int compared = 0, agreed = 0;
@@ -137,7 +168,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   config.particles = o.particles;
   config.seed = o.seed;
   config.candidates = o.candidates;
-  TopologyParticleFilter filter(config, similarity);
+  const TimedSimilarity timed(similarity);
+  TopologyParticleFilter filter(config, timed);
   CandidateSelectionConfig exhaustive = o.candidates;
   exhaustive.exhaustive_up_to = 1000000000;
 
@@ -164,7 +196,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   // The plot: per 1 % of the run, the median and p99 ms of its steps and the resident MB at its end.
   const int plot_every = std::max(1, o.places / 100);
   double window_comparisons = 0;
-  std::vector<double> window_ms, plot_window_ms, plot_x, plot_median, plot_p99, plot_rss;
+  std::vector<double> window_ms, window_compare_ms, window_rest_ms, plot_window_ms, plot_window_rest_ms, plot_x,
+      plot_median, plot_p99, plot_rest, plot_rss;
   int compared = 0, agreed = 0, window_compared = 0, window_agreed = 0;
   int confident = 0, confident_agreed = 0, window_confident = 0, window_confident_agreed = 0;
   int control_same = 0, control_confident = 0, control_confident_same = 0;
@@ -172,10 +205,11 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
   if (!o.json)
     std::printf("map-size: %d steps, %d particles, %zu donor frames of %s; exhaustive up to %d stored, then %d "
                 "candidates + %d background samples; decisions compared every %d steps\n%8s %8s %10s %10s %10s "
-                "%8s %9s %9s %14s %14s\n",
+                "%8s %9s %9s %14s %14s %8s %8s %8s\n",
                 o.places, o.particles, donors.size(), o.samples.c_str(), o.candidates.exhaustive_up_to,
                 o.candidates.candidates, o.candidates.background_samples, o.compare_every, "steps", "stored",
-                "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "compared", "same decision", "when p >= 0.5");
+                "median ms", "p99 ms", "max ms", "RSS MB", "index MB", "compared", "same decision", "when p >= 0.5",
+                "cmp ms", "rest ms", "est ms");
   for (int k = 0; k < o.places; ++k) {
     const auto observation = observationOf(prototype(route[static_cast<std::size_t>(k)]), rng);
     std::unique_ptr<TopologyParticleFilter> shadow;
@@ -183,10 +217,15 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       shadow = filter.fork();
       shadow->setCandidateSelection(exhaustive);
     }
+    timed.takeMs();  // the shadows' comparisons are not the step's
     Stopwatch watch;
     filter.step(observation);
     const double ms = watch.elapsedMs();
+    const double compare_ms = timed.takeMs();
     window_ms.push_back(ms);
+    window_compare_ms.push_back(compare_ms);
+    window_rest_ms.push_back(ms - compare_ms);
+    plot_window_rest_ms.push_back(ms - compare_ms);
     window_comparisons += static_cast<double>(filter.lastStepComparisons());
     plot_window_ms.push_back(ms);
     if ((k + 1) % plot_every == 0) {
@@ -194,6 +233,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       plot_x.push_back(k + 1);
       plot_median.push_back(s.median_ms);
       plot_p99.push_back(s.p99_ms);
+      plot_rest.push_back(summarize(plot_window_rest_ms).median_ms);
+      plot_window_rest_ms.clear();
       plot_rss.push_back(static_cast<double>(residentBytes()) / (1024.0 * 1024.0));
       plot_window_ms.clear();
     }
@@ -235,6 +276,16 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       c.steps = k + 1;
       c.stored = filter.memoryStats().stored_fingerprints;
       c.step = summarize(window_ms);
+      {
+        Stopwatch estimate_watch;
+        const TopologyEstimate e = filter.estimate(4);
+        c.estimate_ms = estimate_watch.elapsedMs();
+        if (e.observations != k + 1) throw std::logic_error("bench map-size: estimate out of step");
+      }
+      c.compare = summarize(window_compare_ms);
+      c.rest = summarize(window_rest_ms);
+      window_compare_ms.clear();
+      window_rest_ms.clear();
       c.comparisons = window_comparisons / static_cast<double>(window_ms.size());
       window_comparisons = 0;
       c.rss_mb = static_cast<double>(residentBytes()) / (1024.0 * 1024.0);
@@ -247,9 +298,10 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       window_ms.clear();
       window_compared = window_agreed = window_confident = window_confident_agreed = 0;
       if (!o.json) {
-        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %9.0f %8d of %3d %8d of %3d\n", c.steps, c.stored,
-                    c.step.median_ms, c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.comparisons, c.agreed, c.compared,
-                    c.confident_agreed, c.confident);
+        std::printf("%8d %8zu %10.2f %10.2f %10.2f %8.1f %9.1f %9.0f %8d of %3d %8d of %3d %8.2f %8.2f %8.2f\n", c.steps,
+                    c.stored, c.step.median_ms, c.step.p99_ms, c.step.max_ms, c.rss_mb, c.index_mb, c.comparisons,
+                    c.agreed, c.compared, c.confident_agreed, c.confident, c.compare.median_ms, c.rest.median_ms,
+                    c.estimate_ms);
         std::fflush(stdout);
       }
     }
@@ -271,6 +323,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
       json.beginObject();
       json.field("steps", c.steps).field("stored", c.stored).field("median_ms", c.step.median_ms);
       json.field("p99_ms", c.step.p99_ms).field("max_ms", c.step.max_ms).field("rss_mb", c.rss_mb);
+      json.field("compare_median_ms", c.compare.median_ms).field("rest_median_ms", c.rest.median_ms);
+      json.field("estimate_ms", c.estimate_ms);
       json.field("index_mb", c.index_mb).field("comparisons_per_step", c.comparisons).field("compared", c.compared).field("same", c.agreed);
       json.field("confident", c.confident).field("confident_same", c.confident_agreed);
       json.endObject();
@@ -297,6 +351,8 @@ void runMapSizeBench(const MapSizeBenchOptions& o) {
     time.y_label = "ms per step / MB resident";
     time.series.push_back(SvgSeries{"ms per step, median per 1 % of the run", plot_x, plot_median, "#1f77b4", 1.5});
     time.series.push_back(SvgSeries{"ms per step, p99 per 1 % of the run", plot_x, plot_p99, "#9ecae1", 1.0});
+    time.series.push_back(
+        SvgSeries{"ms per step outside the exact comparisons, median per 1 %", plot_x, plot_rest, "#2ca02c", 1.5});
     time.series.push_back(SvgSeries{"resident MB (VmRSS)", plot_x, plot_rss, "#d62728", 2.0});
     time.horizontal_lines.push_back(SvgLine{200.0, "#d62728", true, "200 MB"});
     time.y_min = 0.0;
