@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -49,7 +51,11 @@ TEST_CASE("GIVEN an output file WHEN committed THEN the target holds the text an
 }
 
 TEST_CASE("GIVEN /dev/full WHEN written THEN commit throws naming it", "[core][output][reliability]") {
-  if (!fs::exists("/dev/full")) return;
+  if (!fs::exists("/dev/full")) {
+    // The full-disk path needs /dev/full (a container may lack it): skipped (ctest's SKIP_RETURN_CODE).
+    std::fprintf(stderr, "skipped: /dev/full does not exist here; the full-disk path cannot be exercised\n");
+    std::_Exit(77);
+  }
   OutputFile out("/dev/full");
   out << "image,expected\n";
   CHECK_THROWS_WITH(out.commit(), Catch::Contains("/dev/full: write failed: No space left on device"));
