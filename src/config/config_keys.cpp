@@ -118,7 +118,7 @@ ConfigKey choice(std::string path, Access access, const std::string& def, const 
 
 // The five keys of one pipeline thread.
 void addThread(std::vector<ConfigKey>& keys, const std::string& thread, ThreadSettings PipelineThreads::*member,
-               const std::string& def_name) {
+               const std::string& def_name, int def_nice = 0) {
   const std::string p = "pipeline.threads." + thread + ".";
   const auto at = [member](auto& c) -> auto& { return c.pipeline.threads.*member; };
   keys.push_back(text(p + "name", [at](auto& c) -> auto& { return at(c).name; }, def_name, 1, 15,
@@ -140,7 +140,7 @@ void addThread(std::vector<ConfigKey>& keys, const std::string& thread, ThreadSe
                          return std::to_string(t.priority) + " is out of range for policy other, allowed 0";
                        return "";
                      }));
-  keys.push_back(integer(p + "nice", [at](auto& c) -> auto& { return at(c).nice; }, 0, -20, 19, "",
+  keys.push_back(integer(p + "nice", [at](auto& c) -> auto& { return at(c).nice; }, def_nice, -20, 19, "",
                          "nice value with policy other (0 = leave as is)"));
 }
 
@@ -263,6 +263,8 @@ std::vector<ConfigKey> makeKeys() {
   addThread(k, "topology", &PipelineThreads::topology, "tsl-topology");
   addThread(k, "publisher", &PipelineThreads::publisher, "tsl-publish");
   addThread(k, "map_writer", &PipelineThreads::map_writer, "tsl-mapsave");
+  addThread(k, "lcm_receiver", &PipelineThreads::lcm_receiver, "tsl-lcm-rx");
+  addThread(k, "recorder", &PipelineThreads::recorder, "tsl-record", 10);
   k.push_back(real("pipeline.filter_budget_ms", AT(pipeline.filter_budget_ms), 5.0, 0.1, 1000, "milliseconds",
                    "topology filter work per frame"));
   k.push_back(real("pipeline.status_period_s", AT(pipeline.status_period_s), 1.0, 0.1, 60, "seconds",
@@ -616,6 +618,8 @@ const std::vector<ConfigSection>& daemonConfigSections() {
       {"pipeline.threads.topology", "runs the particle filter over topologies"},
       {"pipeline.threads.publisher", "publishes over LCM"},
       {"pipeline.threads.map_writer", "writes map snapshots (fsync off the frame path)"},
+      {"pipeline.threads.lcm_receiver", "toposlamd: receives LCM input (robot motion)"},
+      {"pipeline.threads.recorder", "toposlamd with record.dir: encodes and writes the recorded frames"},
       {"fingerprint", "VPACK fingerprint (thesis ch. 3, docs/fingerprint.md)"},
       {"fingerprint.edges", "vertical edges"},
       {"fingerprint.histogram", "HCL colour histograms"},

@@ -52,7 +52,8 @@ std::string PipelineConfig::validate() const {
   const std::pair<const char*, const ThreadSettings*> thread_table[] = {
       {"threads.capture", &this->threads.capture},       {"threads.fingerprint", &this->threads.fingerprint},
       {"threads.segmentation", &this->threads.segmentation}, {"threads.topology", &this->threads.topology},
-      {"threads.publisher", &this->threads.publisher},   {"threads.map_writer", &this->threads.map_writer}};
+      {"threads.publisher", &this->threads.publisher},   {"threads.map_writer", &this->threads.map_writer},
+      {"threads.lcm_receiver", &this->threads.lcm_receiver}, {"threads.recorder", &this->threads.recorder}};
   for (const auto& [key, settings] : thread_table)
     if (std::string problem = settings->validate(); !problem.empty()) return std::string(key) + "." + problem;
   if (!(filter_budget_ms >= 0.1 && filter_budget_ms <= 1000.0))

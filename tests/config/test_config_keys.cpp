@@ -129,7 +129,8 @@ SCENARIO("GIVEN the effective config printed as YAML WHEN it is read back THEN e
       DaemonConfig fifo;
       for (ThreadSettings* t : {&fifo.pipeline.threads.capture, &fifo.pipeline.threads.fingerprint,
                                 &fifo.pipeline.threads.segmentation, &fifo.pipeline.threads.topology,
-                                &fifo.pipeline.threads.publisher, &fifo.pipeline.threads.map_writer}) {
+                                &fifo.pipeline.threads.publisher, &fifo.pipeline.threads.map_writer,
+                                &fifo.pipeline.threads.lcm_receiver, &fifo.pipeline.threads.recorder}) {
         t->policy = SchedulingPolicy::Fifo;
         t->priority = 10;
       }

@@ -66,6 +66,10 @@ struct PipelineThreads {
   ThreadSettings topology{"tsl-topology"};
   ThreadSettings publisher{"tsl-publish"};
   ThreadSettings map_writer{"tsl-mapsave"};
+  /// The daemon's two I/O threads, started beside the Pipeline's (toposlamd): the LCM receiver (motion
+  /// input) and, with record.dir, the recording's writer (nice 10: it yields to the stage threads).
+  ThreadSettings lcm_receiver{"tsl-lcm-rx"};
+  ThreadSettings recorder{"tsl-record", -1, SchedulingPolicy::Other, 0, 10};
 };
 
 /// pipeline.*: queues, threads, budgets.

@@ -321,13 +321,13 @@ int runDaemon(const DaemonConfig& config) {
       if (recording != nullptr) recording->closeWriter();
     }
   } end_io_threads{receiving, recording};
-  io_threads.start(ThreadSettings{"tsl-lcm-rx"}, [&] {
+  io_threads.start(config.pipeline.threads.lcm_receiver, [&] {
     while (receiving.load())
       if (!motion.handle(200)) break;
   });
-  // The recording's writer: nice 10, so encoding and writing frames yield to the pipeline's threads.
+  // The recording's writer: nice 10 by default, so encoding and writing frames yield to the stage threads.
   if (recording != nullptr)
-    io_threads.start(ThreadSettings{"tsl-record", -1, SchedulingPolicy::Other, 0, 10}, [recording] { recording->runWriter(); });
+    io_threads.start(config.pipeline.threads.recorder, [recording] { recording->runWriter(); });
   pipeline.start();
   notifier.ready();
   notifier.status("running: " + parts.source->describe());
