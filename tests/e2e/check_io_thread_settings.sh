@@ -1,0 +1,33 @@
+#!/bin/sh
+# The daemon's I/O threads come from the one thread table (pipeline.threads.lcm_receiver / .recorder):
+# names and nice values set in the config file are the ones the running toposlamd's threads carry.
+# Exits 77 (skipped) without /proc. Usage: check_io_thread_settings.sh TOPOSLAMD SAMPLES_DIR WORK_DIR
+set -eu
+toposlamd=$1 samples=$2 work=$3
+[ -d /proc/self/task ] || { echo "skipped: no /proc/self/task here"; exit 77; }
+rm -rf "$work" && mkdir -p "$work"
+cat > "$work/config.yaml" <<'YAML'
+pipeline:
+  threads:
+    lcm_receiver:
+      name: tsl-rx-custom
+    recorder:
+      name: tsl-rec-custom
+      nice: 5
+YAML
+"$toposlamd" --config "$work/config.yaml" --source "images:$samples?rate=5" --lcm-url memq:// --map "" \
+  --record "$work/rec" > "$work/daemon.log" 2>&1 &
+pid=$!
+found=""
+for _ in 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20; do
+  sleep 0.25
+  found=$(for t in /proc/$pid/task/*; do echo "$(cat "$t/comm" 2>/dev/null) $(cut -d' ' -f19 "$t/stat" 2>/dev/null)"; done | sort)
+  case "$found" in *tsl-rec-custom*) break ;; esac
+done
+kill -TERM $pid 2>/dev/null || true
+wait $pid || true
+echo "$found"
+echo "$found" | grep -qx "tsl-rx-custom 0" || { echo "no thread tsl-rx-custom (nice 0)"; cat "$work/daemon.log"; exit 1; }
+echo "$found" | grep -qx "tsl-rec-custom 5" || { echo "no thread tsl-rec-custom (nice 5)"; cat "$work/daemon.log"; exit 1; }
+if echo "$found" | grep -q "tsl-lcm-rx\|tsl-record"; then echo "a default I/O thread name is still used"; exit 1; fi
+echo "io threads as configured"
