@@ -148,7 +148,9 @@ struct SegmentedPlace {
   std::shared_ptr<const Fingerprint> representative;
   int representative_keypoints = 0;
   bool dropped = false;            ///< representative had fewer than min_keypoints keypoints
-  std::int64_t valley_frame = -1;  ///< frame of the lambda2 valley that closed it; -1 when flushed
+  /// Frame of the lambda2 valley that closed it, or (doorway_borders) the border frame of the doorway
+  /// passage that did; -1 when flushed (the end of the stream).
+  std::int64_t valley_frame = -1;
   /// Sequence number among kept places (dropped == false) or among dropped places, from 0.
   std::int64_t index = 0;
 };
