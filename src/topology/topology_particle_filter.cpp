@@ -622,7 +622,9 @@ TopologyEstimate TopologyParticleFilter::estimate(int alternatives) const {
     // Its records since the last one it shares with the best topology; before that it is the best's.
     std::vector<const HistoryRecord*> suffix;
     const HistoryRecord* r = states[order[k]]->record.get();
-    for (; r && estimate_records_[idx(r->observation)] != r; r = r->parent.get()) suffix.push_back(r);
+    for (; r && !(idx(r->observation) < estimate_records_.size() && estimate_records_[idx(r->observation)] == r);
+         r = r->parent.get())
+      suffix.push_back(r);
     const std::size_t shared = r ? idx(r->observation) + 1 : 0;
     h.assignment.assign(estimate_assignment_.begin(), estimate_assignment_.begin() + static_cast<std::ptrdiff_t>(shared));
     for (auto it = suffix.rbegin(); it != suffix.rend(); ++it) h.assignment.push_back((*it)->node);
