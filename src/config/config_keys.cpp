@@ -442,11 +442,14 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("topology.relative_slope", AT(topology.relative_slope), 2.0, 0, 100, "",
                    "relative likelihood: logistic slope per z unit")
                   .exclusive(true, false));
-  k.push_back(real("topology.relative_offset", AT(topology.relative_offset), 8.0, -10, 10, "",
+  k.push_back(real("topology.relative_offset", AT(topology.relative_offset), 4.25, -10, 10, "",
                    "relative likelihood: z (leave-one-out, among the stored representatives) at likelihood 1/2"));
   k.push_back(real("topology.relative_sigma_floor", AT(topology.relative_sigma_floor), 0.02, 0, 1, "",
                    "relative likelihood: smallest spread of the other similarities")
                   .exclusive(true, false));
+  k.push_back(flag("topology.new_node_entropy", AT(topology.new_node_entropy), false,
+                   "a new node's likelihood is eta (1 - max L), eta the normalised entropy of eq. 5.7 (thesis); "
+                   "false: 1 - max L (docs/topology.md, \"The new node's likelihood\")"));
   k.push_back(real("topology.alpha", AT(topology.alpha), 15.0, 0, 1e6, "", "expected number of places (thesis: 15)")
                   .exclusive(true, false));
   k.push_back(real("topology.new_node_probability", AT(topology.new_node_probability), 0.05, 0, 1, "",

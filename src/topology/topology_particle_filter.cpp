@@ -332,8 +332,10 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           aggregate(g.nodes.root().get(), g.nodes.levels(), stamp_, similarity_of_, l_log_l_memo);
           const TrieNode& root = *g.nodes.root();
           stats.max = root.memo_max;
-          stats.new_likelihood =
-              entropyFromSums(root.memo_sum, root.memo_sum_l_log_l, g.nodeCount()) * (1.0 - stats.max);
+          const double eta = config_.new_node_entropy
+                                 ? entropyFromSums(root.memo_sum, root.memo_sum_l_log_l, g.nodeCount())
+                                 : 1.0;
+          stats.new_likelihood = eta * (1.0 - stats.max);
         }
         phase_ = Phase::Resample;
         cursor_ = 0;
@@ -767,6 +769,8 @@ void FrozenTopologyState::saveState(std::ostream& out) const {
   w.f64(config_.relative_slope);
   w.f64(config_.relative_offset);
   w.f64(config_.relative_sigma_floor);
+  // Second extension block (absent in maps written before it: those used eq. 5.7's entropy).
+  w.u8(config_.new_node_entropy ? 1 : 0);
   const std::string& data = w.data();
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
 }
@@ -876,6 +880,7 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     config.relative_slope = r.f64("likelihood model");
     config.relative_offset = r.f64("likelihood model");
     config.relative_sigma_floor = r.f64("likelihood model");
+    config.new_node_entropy = r.atEnd() ? true : r.flag("new node likelihood");
     if (const std::string problem = config.validate(); !problem.empty())
       throw std::runtime_error("map data: bad filter config: " + problem);
   } else {

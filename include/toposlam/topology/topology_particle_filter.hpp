@@ -108,6 +108,12 @@ struct TopologyFilterConfig {
   double relative_slope = 3.0;         ///< logistic slope per z unit; allowed (0, 100]
   double relative_offset = 2.5;        ///< z at which the likelihood is 1/2; allowed [-10, 10]
   double relative_sigma_floor = 0.02;  ///< smallest spread of the others' similarities; allowed (0, 1]
+  /// Eq. 5.7: a new node's likelihood is eta (1 - max L), eta the normalised entropy of the known nodes'
+  /// likelihoods (the thesis). Off: 1 - max L. The relative likelihood is already relative to the other
+  /// places, and normalising its near-zero values makes eta collapse: one place at L = 0.035 took 0.97 of
+  /// the particles (docs/topology.md, "The new node's likelihood"). Saved with the map; maps written
+  /// before it existed load with it on.
+  bool new_node_entropy = true;
   /// Not part of the saved state (a loaded map has the defaults until setCandidateSelection()).
   CandidateSelectionConfig candidates;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".

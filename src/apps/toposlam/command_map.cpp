@@ -87,6 +87,8 @@ struct MapOptions {
   CLI::Option* likelihood_given = nullptr;
   CLI::Option* slope_given = nullptr;
   CLI::Option* offset_given = nullptr;
+  bool new_node_entropy = methodPreset("default").topology.new_node_entropy;
+  CLI::Option* entropy_given = nullptr;
   CLI::Option* floor_given = nullptr;
 };
 
@@ -211,6 +213,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (o.likelihood_given->count() > 0) config.likelihood = parseLikelihoodModel(o.likelihood);
     if (o.slope_given->count() > 0) config.relative_slope = o.relative_slope;
     if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
+    if (o.entropy_given->count() > 0) config.new_node_entropy = o.new_node_entropy;
     if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
     config.candidates = o.candidates;
     if (const std::string problem = config.validate(); !problem.empty())
@@ -579,6 +582,11 @@ void addMapCommand(CLI::App& app) {
           ->capture_default_str();
   options->offset_given =
       cmd->add_option("--relative-offset", options->relative_offset, "Relative likelihood: z at which it is 1/2")
+          ->capture_default_str();
+  options->entropy_given =
+      cmd->add_option("--new-node-entropy", options->new_node_entropy,
+                      "Filter: a new node's likelihood is eta (1 - max L), eta eq. 5.7's entropy (true, thesis), "
+                      "or 1 - max L (false; docs/topology.md)")
           ->capture_default_str();
   options->floor_given = cmd->add_option("--relative-sigma-floor", options->relative_sigma_floor,
                                          "Relative likelihood: smallest spread of the other similarities")
