@@ -7,12 +7,26 @@
 #include <map>
 #include <sstream>
 
+#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace toposlam {
+
+FingerprintedFrame VpackFingerprintStage::process(const cv::Mat& image, const cv::Mat& grey) {
+  FingerprintedFrame out{extractor_.extract(image, grey), cv::Mat()};
+  if (thumbnail_width_ > 0) {
+    const int width = std::min(thumbnail_width_, image.cols);
+    const double scaled_rows = static_cast<double>(image.rows) * width / image.cols;
+    const int height = std::max(1, static_cast<int>(std::lround(scaled_rows)));
+    cv::resize(image, out.thumbnail, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
 
 FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
                                                    const SimilarityMeasure& similarity,

@@ -23,7 +23,8 @@ void OfflineRunner::beginTraversal() {
 }
 
 std::shared_ptr<const Fingerprint> OfflineRunner::fingerprint(const cv::Mat& image, const cv::Mat& grey) {
-  return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey));
+  // The thumbnail, if the stage makes one, is for place events, which the offline commands do not publish.
+  return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey).fingerprint);
 }
 
 SegmenterStep OfflineRunner::segment(double source_time_s, const std::string& name,

@@ -10,7 +10,6 @@
 #include <utility>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "toposlam/platform/thread_os.hpp"
@@ -61,8 +60,6 @@ std::string PipelineConfig::validate() const {
   if (opencv_threads < 0 || opencv_threads > 64) return rangeError("opencv_threads", opencv_threads, "0 .. 64 (threads)");
   if (!(status_period_s >= 0.1 && status_period_s <= 60.0))
     return rangeError("status_period_s", status_period_s, "0.1 .. 60 (seconds)");
-  if (thumbnail_width < 16 || thumbnail_width > 1280)
-    return rangeError("thumbnail_width", thumbnail_width, "16 .. 1280 (pixels)");
   return "";
 }
 
@@ -288,12 +285,9 @@ void Pipeline::fingerprintLoop() {
       const double t0 = clock_.now();
       Fingerprinted out;
       try {
-        out.fingerprint = std::make_shared<const Fingerprint>(
-            fingerprint_.process(captured.frame.image, captured.frame.grey));
-        const cv::Mat& image = captured.frame.image;
-        const int width = std::min(config_.thumbnail_width, image.cols);
-        const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
-        cv::resize(image, out.thumbnail, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+        FingerprintedFrame made = fingerprint_.process(captured.frame.image, captured.frame.grey);
+        out.fingerprint = std::make_shared<const Fingerprint>(std::move(made.fingerprint));
+        out.thumbnail = std::move(made.thumbnail);
       } catch (const std::exception& e) {
         // A bad frame from the world: counted, logged now and then, survived.
         if (failures++ % 100 == 0) spdlog::warn("fingerprint: frame {} skipped ({} so far): {}", captured.frame.sequence, failures, e.what());

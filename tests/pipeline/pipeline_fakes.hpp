@@ -111,13 +111,15 @@ class AbsentCameraSource final : public FrameSource {
 
 class FakeFingerprint final : public FingerprintStage {
  public:
-  Fingerprint process(const cv::Mat& image, const cv::Mat& /*grey*/) override {
+  FingerprintedFrame process(const cv::Mat& image, const cv::Mat& /*grey*/) override {
     const int value = image.at<cv::Vec3b>(0, 0)[0];
     if (on_process) on_process(value);
     if (throw_when && throw_when(value)) throw std::invalid_argument("unreadable frame");
-    Fingerprint f;
-    f.image_width = image.cols;
-    f.image_height = image.rows;
+    FingerprintedFrame f;
+    f.fingerprint.image_width = image.cols;
+    f.fingerprint.image_height = image.rows;
+    // A 2x1 thumbnail whose pixels say which frame it was made of (sequence % 256).
+    f.thumbnail = cv::Mat(1, 2, CV_8UC3, cv::Scalar::all(static_cast<double>(value)));
     return f;
   }
   std::function<void(int)> on_process;   ///< argument: the frame's pixel value (sequence % 256)

@@ -83,6 +83,18 @@ SCENARIO("The filter step of a place is spread over the following frames within 
       for (const FrameResult& r : sink.results)
         if (r.has_frame) CHECK(r.filter_ms <= 2.0 + 1e-6);
     }
+    THEN("each place carries the thumbnail the fingerprint stage made of the frame that closed it") {
+      int with_thumbnail = 0;
+      for (const FrameResult& r : sink.results)
+        for (const auto& [place, assignment] : r.finished_places) {
+          if (assignment.place == 9) continue;  // closed by the end of the stream: no frame, no thumbnail
+          REQUIRE(place.thumbnail.size() == cv::Size(2, 1));
+          // FakeFingerprint paints its thumbnail with the frame's value (sequence % 256).
+          CHECK(place.thumbnail.at<cv::Vec3b>(0, 1)[0] == 10 * assignment.place + 9);
+          ++with_thumbnail;
+        }
+      CHECK(with_thumbnail == 9);
+    }
     THEN("the estimate of frame 11 is place 0 on node 0, and frame 41 sees the loop close (place 3 -> node 0)") {
       CHECK(sink.results[11].estimate.place == 0);
       CHECK(sink.results[10].estimate.place == -1);

@@ -7,12 +7,12 @@
 // and counts it (overflow: drop_oldest, the real-time default), or the producer waits (overflow: block,
 // for lossless replay of files). Records that carry a place (a closed place, a finished step, a new
 // topology) are never dropped. Frames are not copied: the capture queue carries the source's Frame (its
-// buffer_lease keeps the driver buffer); the fingerprint thread releases it as soon as the fingerprint and
-// a small thumbnail are made. The topology filter's step for a place is spread over the following frames:
-// per frame the topology thread spends at most `filter_budget_ms` in TopologyStage::advance(). A status is
-// published every `status_period_s`. The map is saved atomically every `MapConfig::save_period_s` and at
-// stop: the topology thread takes an in-memory snapshot, the map writer thread writes it (fsync off the
-// frame path).
+// buffer_lease keeps the driver buffer); the fingerprint thread releases it as soon as the fingerprint
+// stage has made the fingerprint and a small thumbnail (FingerprintedFrame). The topology filter's step for
+// a place is spread over the following frames: per frame the topology thread spends at most
+// `filter_budget_ms` in TopologyStage::advance(). A status is published every `status_period_s`. The map
+// is saved atomically every `MapConfig::save_period_s` and at stop: the topology thread takes an in-memory
+// snapshot, the map writer thread writes it (fsync off the frame path).
 //
 // The capture thread reads the source with a bounded wait (FrameSource::nextFor), so it keeps beating
 // while a camera is silent or reconnecting: that is healthy, and the status says "reconnecting". A stage
@@ -78,7 +78,6 @@ struct PipelineConfig {
   PipelineThreads threads;
   double filter_budget_ms = 5.0;     ///< topology work per frame, milliseconds (0.1 .. 1000)
   double status_period_s = 1.0;      ///< status message period (0.1 .. 60)
-  int thumbnail_width = 160;         ///< place-event thumbnail width in pixels (16 .. 1280), height keeps aspect
   bool record_latencies = false;     ///< keep every frame's capture-to-publish latency (benchmark)
   /// OpenCV's own thread pool, set at start (cv::setNumThreads, process-wide). 1: OpenCV runs each call
   /// on the calling stage thread, so the only threads are the table's and the fingerprint workers

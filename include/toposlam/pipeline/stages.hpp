@@ -88,13 +88,22 @@ struct TopologySnapshot {
 
 // ---------------------------------------------------------------------------------------------------
 
-/// Frame -> fingerprint. Must not keep a reference to the frame's pixels after returning: the
-/// frame's buffer goes back to the source right after.
+/// What the fingerprint stage makes of one frame: everything later stages need of its pixels, so the
+/// frame's buffer can go back to the source.
+struct FingerprintedFrame {
+  Fingerprint fingerprint;
+  /// Small copy of the frame (BGR, or grey as the frame) for the place event of the place it may end up
+  /// representing; empty when the stage makes none.
+  cv::Mat thumbnail;
+};
+
+/// Frame -> fingerprint and thumbnail. Must not keep a reference to the frame's pixels after returning:
+/// the frame's buffer goes back to the source right after (the thumbnail is a copy).
 class FingerprintStage {
  public:
   virtual ~FingerprintStage() = default;
   /// image: the frame (BGR, or grey); grey: the camera's own grey of it, or empty (Frame::grey).
-  virtual Fingerprint process(const cv::Mat& image, const cv::Mat& grey) = 0;
+  virtual FingerprintedFrame process(const cv::Mat& image, const cv::Mat& grey) = 0;
 };
 
 /// Fingerprint -> Fiedler value and, now and then, a closed place. Called for every frame, in order.
