@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <iterator>
 #include <stdexcept>
 #include <utility>
@@ -393,19 +392,26 @@ void Pipeline::mapWriterLoop() {
 }
 
 void Pipeline::topologyLoop() {
-  std::deque<ClosedPlace> pending;  // places whose step is queued or in progress, oldest first
   std::int64_t published_revision = -1;
   double next_save_s = clock_.now() + (map_.save_period_s > 0 ? map_.save_period_s : 0.0);
   const double budget_s = config_.filter_budget_ms * 1e-3;
+  std::int64_t place_queue_full = 0;
 
-  auto attach = [&](FrameResult& r, const PlaceAssignment& assignment) {
-    ClosedPlace place;
-    if (!pending.empty()) {
-      place = std::move(pending.front());
-      pending.pop_front();
+  // The topology stage's queue is the one place a closed place waits for its step. Bounded: when it is
+  // full, the oldest step is finished now, whatever the frame's budget (the frames behind wait, and a
+  // drop-oldest queue drops their estimates, counted); counted as a kept wait. Places are never dropped.
+  auto enqueueBounded = [&](FrameResult& r, ClosedPlace place) {
+    if (topology_.queuedPlaces() >= kPlaceQueueCapacity) {
+      place_queue_kept_waits_.fetch_add(1);
+      if (place_queue_full++ % 100 == 0)
+        spdlog::warn("pipeline: the topology filter is {} places behind; finishing the oldest step now ({} times "
+                     "so far)", topology_.queuedPlaces(), place_queue_full);
+      while (topology_.queuedPlaces() >= kPlaceQueueCapacity)
+        if (std::optional<FinishedPlace> done = topology_.advance(1e9))
+          r.finished_places.push_back(std::move(*done));
     }
-    place.place = assignment.place;
-    r.finished_places.emplace_back(std::move(place), assignment);
+    topology_.enqueuePlace(std::move(place));
+    place_queue_high_water_.store(std::max(place_queue_high_water_.load(), topology_.queuedPlaces()));
   };
   auto stampEstimate = [&](FrameResult& r) {
     r.estimate = topology_.estimate();
@@ -428,8 +434,7 @@ void Pipeline::topologyLoop() {
       if (wait == QueueWait::Item) {
         const double t0 = clock_.now();
         if (r.closed_place) {
-          topology_.enqueuePlace(*r.closed_place);
-          pending.push_back(std::move(*r.closed_place));
+          enqueueBounded(r, std::move(*r.closed_place));
           r.closed_place.reset();
           places_.fetch_add(1);
         }
@@ -438,7 +443,8 @@ void Pipeline::topologyLoop() {
         while (!topology_.idle()) {
           const double remaining = deadline - clock_.now();
           if (remaining <= 0.0) break;
-          if (std::optional<PlaceAssignment> done = topology_.advance(remaining)) attach(r, *done);
+          if (std::optional<FinishedPlace> done = topology_.advance(remaining))
+            r.finished_places.push_back(std::move(*done));
         }
         stampEstimate(r);
         r.filter_ms = (clock_.now() - t0) * 1e3;
@@ -458,7 +464,8 @@ void Pipeline::topologyLoop() {
     FrameResult flush;
     flush.has_frame = false;
     while (!topology_.idle())
-      if (std::optional<PlaceAssignment> done = topology_.advance(1e9)) attach(flush, *done);
+      if (std::optional<FinishedPlace> done = topology_.advance(1e9))
+        flush.finished_places.push_back(std::move(*done));
     stampEstimate(flush);
     if (!flush.finished_places.empty() || flush.topology) results_->pushWait(std::move(flush));
   } catch (const std::exception& e) {
@@ -498,6 +505,7 @@ StatusCounters Pipeline::statusCounters(std::int64_t published) const {
   c.source_reconnect_attempts = source_reconnect_attempts_.load();
   c.source_dropped = source_dropped_.load();
   c.places = places_.load();
+  c.place_queue_kept_waits = place_queue_kept_waits_.load();
   c.map_revision = map_revision_.load();
   c.maps_saved = maps_saved_.load();
   return c;

@@ -194,8 +194,9 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   }
   std::int64_t lastMappedFrame() const { return last_mapped_frame_; }
 
-  void enqueuePlace(const ClosedPlace& place) override;
-  std::optional<PlaceAssignment> advance(double budget_s) override;
+  void enqueuePlace(ClosedPlace place) override;
+  std::optional<FinishedPlace> advance(double budget_s) override;
+  std::size_t queuedPlaces() const override { return queue_.size(); }
   bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
   const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override { return topology_; }
@@ -215,14 +216,8 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   int alternatives_;
   CandidateSelectionConfig candidates_;  ///< re-applied to a loaded map
   std::unique_ptr<TopologyParticleFilter> filter_;
-  /// A closed place waiting for (or in) its filter step: the front one while a step is in progress.
-  struct QueuedPlace {
-    std::shared_ptr<const Fingerprint> representative;
-    std::int64_t representative_frame = -1;
-    std::int64_t last_frame = -1;
-    std::vector<double> evidence;  ///< by earlier place of this run (ClosedPlace::evidence)
-  };
-  std::deque<QueuedPlace> queue_;
+  /// Closed places waiting for (or in) their filter step: the front one while a step is in progress.
+  std::deque<ClosedPlace> queue_;
   std::vector<std::int64_t> representative_frames_;  ///< per observation (-1: from an older run)
   std::function<std::string(std::int64_t)> name_of_;
   std::int64_t last_mapped_frame_ = -1;  ///< the last frame of the last place stepped (or of the resumed map)

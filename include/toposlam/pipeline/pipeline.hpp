@@ -1,6 +1,7 @@
 // The real-time pipeline: five named stage threads and a map writer, created at start and joined at stop,
 //
 //   capture --q--> fingerprint --q--> segmentation --q--> topology --q--> publisher
+//                                                         (places q)
 //                                                            `--snapshot--> map writer
 //
 // connected by BoundedQueues. When a stage falls behind, its input queue drops the OLDEST per-frame item
@@ -158,6 +159,14 @@ class Pipeline {
   /// What a full queue does in this run: queues.overflow with Auto resolved for the source.
   QueueOverflow overflow() const { return config_.queues.overflow; }
 
+  /// Places that may wait in the topology stage's queue (TopologyStage::queuedPlaces, the one in its step
+  /// included). A place closed when it is full first has the oldest step finished, beyond the frame's
+  /// budget (a kept wait, PipelineStatus::queue_kept_waits): the filter may fall behind by this many places,
+  /// no more; places are never dropped.
+  static constexpr std::size_t kPlaceQueueCapacity = 16;
+  /// Most places the topology stage's queue held at once (any thread).
+  std::size_t placeQueueHighWater() const { return place_queue_high_water_.load(); }
+
  private:
   struct CapturedFrame;
   struct Fingerprinted;
@@ -212,6 +221,8 @@ class Pipeline {
   std::atomic<double> thread_cpu_s_[kThreadCount] = {};  ///< CPU time of each stage thread so far
   std::atomic<std::int64_t> maps_saved_{0};
   std::atomic<int> places_{0};
+  std::atomic<std::int64_t> place_queue_kept_waits_{0};  ///< the place queue was full (topology thread)
+  std::atomic<std::size_t> place_queue_high_water_{0};
   // Copied by their owning thread so the publisher never calls into another thread's stage or source.
   std::atomic<std::int64_t> map_revision_{0};
   std::atomic<std::int64_t> source_skipped_{0};
