@@ -2,7 +2,8 @@
 // fingerprint is the extractor's; the place-event thumbnail is made here, from the frame it was given),
 // FiedlerSegmentationStage (a closed place carries its representative's thumbnail) and
 // ParticleFilterTopologyStage (its one queue of places: each comes back whole with the filter's decision,
-// numbered by the filter, also after a resumed map).
+// numbered by the filter, also after a resumed map; advance() stops when its budget is spent, and slicing
+// changes no decision).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -272,4 +273,60 @@ TEST_CASE("GIVEN frames with thumbnails WHEN the segmentation stage closes a pla
   }
   CHECK(closed[0].first_frame == 0);
   CHECK(closed[1].last_frame == 79);
+}
+
+namespace {
+
+/// A clock that moves one tick (2^-10 s, about 1 ms: exact in binary, so no rounding decides a comparison)
+/// each time it is read: the topology stage's budget counts its own readings.
+class TickingClock final : public Clock {
+ public:
+  static constexpr double kTick = 1.0 / 1024.0;
+  double now() const override { return kTick * static_cast<double>(readings_++); }
+  std::int64_t readings() const { return readings_; }
+
+ private:
+  mutable std::int64_t readings_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("GIVEN a budget of 3 ticks on a clock that ticks each reading WHEN the topology stage advances "
+          "THEN each call stops after 3 slices, a step takes many calls, and the decisions are unchanged",
+          "[pipeline][stages][topology]") {
+  const test::TableSimilarity similarity(firstAndThirdAlike);
+  TickingClock ticking;
+  ManualClock still;
+  ParticleFilterTopologyStage sliced(smallFilter(), similarity, ticking, {8, 3});
+  ParticleFilterTopologyStage whole(smallFilter(), similarity, still, {8, 3});
+  for (int i = 0; i < 3; ++i) {
+    sliced.enqueuePlace(closedPlace(i, i + 1, 10 * i));
+    whole.enqueuePlace(closedPlace(i, i + 1, 10 * i));
+  }
+  std::vector<FinishedPlace> from_sliced;
+  int calls = 0, calls_cut_by_budget = 0;
+  while (!sliced.idle()) {
+    const std::int64_t readings_before = ticking.readings();
+    std::optional<FinishedPlace> done = sliced.advance(3 * TickingClock::kTick);
+    ++calls;
+    if (done) {
+      from_sliced.push_back(std::move(*done));
+    } else {
+      // One reading for the deadline, one after each slice: 3 slices, then the budget is spent.
+      CHECK(ticking.readings() - readings_before == 4);
+      ++calls_cut_by_budget;
+    }
+  }
+  const std::vector<FinishedPlace> from_whole = finishAll(whole);
+  REQUIRE(from_sliced.size() == 3);
+  REQUIRE(from_whole.size() == 3);
+  CHECK(calls == calls_cut_by_budget + 3);
+  // 100 particles, 8 work items a slice, 3 slices a call: 24 calls the budget cut short over the 3 steps.
+  CHECK(calls_cut_by_budget == 24);
+  for (std::size_t i = 0; i < 3; ++i) {
+    CHECK(from_sliced[i].assignment.node == from_whole[i].assignment.node);
+    CHECK(from_sliced[i].assignment.is_new == from_whole[i].assignment.is_new);
+    CHECK(from_sliced[i].assignment.probability == from_whole[i].assignment.probability);
+  }
+  CHECK(sliced.topology().probability == whole.topology().probability);
 }
