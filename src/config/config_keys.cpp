@@ -269,8 +269,9 @@ std::vector<ConfigKey> makeKeys() {
                    "topology filter work per frame"));
   k.push_back(real("pipeline.status_period_s", AT(pipeline.status_period_s), 1.0, 0.1, 60, "seconds",
                    "status message period"));
-  k.push_back(integer("pipeline.thumbnail_width", AT(pipeline.thumbnail_width), 160, 16, 1280, "pixels",
-                      "place-event thumbnail width (the height keeps the aspect)"));
+  // The fingerprint stage makes the thumbnails; the key keeps its path from when the Pipeline made them.
+  k.push_back(integer("pipeline.thumbnail_width", AT(fingerprint_stage.thumbnail_width), 160, 16, 1280,
+                      "pixels", "place-event thumbnail width (the height keeps the aspect)"));
   k.push_back(integer("pipeline.opencv_threads", AT(pipeline.opencv_threads), 1, 0, 64, "threads",
                       "OpenCV's own pool, set at start (1: each OpenCV call runs on its stage thread; the thread "
                       "table gives out the parallelism, docs/performance.md)"));

@@ -7,12 +7,26 @@
 #include <map>
 #include <sstream>
 
+#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace toposlam {
+
+FingerprintedFrame VpackFingerprintStage::process(const cv::Mat& image, const cv::Mat& grey) {
+  FingerprintedFrame out{extractor_.extract(image, grey), cv::Mat()};
+  if (thumbnail_width_ > 0) {
+    const int width = std::min(thumbnail_width_, image.cols);
+    const double scaled_rows = static_cast<double>(image.rows) * width / image.cols;
+    const int height = std::max(1, static_cast<int>(std::lround(scaled_rows)));
+    cv::resize(image, out.thumbnail, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
 
 FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig& config,
                                                    const SimilarityMeasure& similarity,
@@ -172,11 +186,9 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   refresh();
 }
 
-void ParticleFilterTopologyStage::enqueuePlace(const ClosedPlace& place) {
-  queue_.push_back(QueuedPlace{place.representative, place.representative_frame, place.last_frame, place.evidence});
-}
+void ParticleFilterTopologyStage::enqueuePlace(ClosedPlace place) { queue_.push_back(std::move(place)); }
 
-std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budget_s) {
+std::optional<FinishedPlace> ParticleFilterTopologyStage::advance(double budget_s) {
   const double deadline = clock_.now() + budget_s;
   do {
     if (!filter_->stepInProgress()) {
@@ -189,21 +201,21 @@ std::optional<PlaceAssignment> ParticleFilterTopologyStage::advance(double budge
       filter_->beginStep(queue_.front().representative, step_evidence_);
     }
     if (filter_->advance(slice_items_)) {
-      const QueuedPlace& done = queue_.front();
-      representative_frames_.push_back(done.representative_frame);
-      if (done.last_frame > last_mapped_frame_) {
-        last_mapped_frame_ = done.last_frame;
+      FinishedPlace done{std::move(queue_.front()), PlaceAssignment{}};
+      queue_.pop_front();
+      representative_frames_.push_back(done.place.representative_frame);
+      if (done.place.last_frame > last_mapped_frame_) {
+        last_mapped_frame_ = done.place.last_frame;
         last_mapped_name_ = name_of_ ? name_of_(last_mapped_frame_) : std::string();
       }
-      queue_.pop_front();
       ++revision_;
       refresh();
-      PlaceAssignment a;
-      a.place = estimate_.place;
-      a.node = estimate_.node;
-      a.is_new = estimate_.is_new;
-      a.probability = estimate_.probability;
-      return a;
+      done.assignment.place = estimate_.place;
+      done.assignment.node = estimate_.node;
+      done.assignment.is_new = estimate_.is_new;
+      done.assignment.probability = estimate_.probability;
+      done.place.place = done.assignment.place;
+      return done;
     }
   } while (clock_.now() < deadline);
   return std::nullopt;

@@ -23,7 +23,8 @@ void OfflineRunner::beginTraversal() {
 }
 
 std::shared_ptr<const Fingerprint> OfflineRunner::fingerprint(const cv::Mat& image, const cv::Mat& grey) {
-  return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey));
+  // The thumbnail, if the stage makes one, is for place events, which the offline commands do not publish.
+  return std::make_shared<const Fingerprint>(fingerprint_.process(image, grey).fingerprint);
 }
 
 SegmenterStep OfflineRunner::segment(double source_time_s, const std::string& name,
@@ -53,7 +54,7 @@ std::optional<MappedPlace> OfflineRunner::mapPlace(const SegmentedPlace& place) 
   if (place.dropped || topology_ == nullptr) return std::nullopt;
   if (!pending_ || pending_->place != place.index)
     throw std::logic_error("OfflineRunner::mapPlace: not the kept place the segmentation closed last");
-  topology_->enqueuePlace(*pending_);
+  topology_->enqueuePlace(std::move(*pending_));
   pending_.reset();
   while (!topology_->idle()) topology_->advance(std::numeric_limits<double>::infinity());
   MappedPlace mapped{place, topology_->filter().estimate(3)};

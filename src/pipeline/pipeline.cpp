@@ -4,13 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <iterator>
 #include <stdexcept>
 #include <utility>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "toposlam/platform/thread_os.hpp"
@@ -61,8 +59,6 @@ std::string PipelineConfig::validate() const {
   if (opencv_threads < 0 || opencv_threads > 64) return rangeError("opencv_threads", opencv_threads, "0 .. 64 (threads)");
   if (!(status_period_s >= 0.1 && status_period_s <= 60.0))
     return rangeError("status_period_s", status_period_s, "0.1 .. 60 (seconds)");
-  if (thumbnail_width < 16 || thumbnail_width > 1280)
-    return rangeError("thumbnail_width", thumbnail_width, "16 .. 1280 (pixels)");
   return "";
 }
 
@@ -288,12 +284,9 @@ void Pipeline::fingerprintLoop() {
       const double t0 = clock_.now();
       Fingerprinted out;
       try {
-        out.fingerprint = std::make_shared<const Fingerprint>(
-            fingerprint_.process(captured.frame.image, captured.frame.grey));
-        const cv::Mat& image = captured.frame.image;
-        const int width = std::min(config_.thumbnail_width, image.cols);
-        const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
-        cv::resize(image, out.thumbnail, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+        FingerprintedFrame made = fingerprint_.process(captured.frame.image, captured.frame.grey);
+        out.fingerprint = std::make_shared<const Fingerprint>(std::move(made.fingerprint));
+        out.thumbnail = std::move(made.thumbnail);
       } catch (const std::exception& e) {
         // A bad frame from the world: counted, logged now and then, survived.
         if (failures++ % 100 == 0) spdlog::warn("fingerprint: frame {} skipped ({} so far): {}", captured.frame.sequence, failures, e.what());
@@ -399,19 +392,26 @@ void Pipeline::mapWriterLoop() {
 }
 
 void Pipeline::topologyLoop() {
-  std::deque<ClosedPlace> pending;  // places whose step is queued or in progress, oldest first
   std::int64_t published_revision = -1;
   double next_save_s = clock_.now() + (map_.save_period_s > 0 ? map_.save_period_s : 0.0);
   const double budget_s = config_.filter_budget_ms * 1e-3;
+  std::int64_t place_queue_full = 0;
 
-  auto attach = [&](FrameResult& r, const PlaceAssignment& assignment) {
-    ClosedPlace place;
-    if (!pending.empty()) {
-      place = std::move(pending.front());
-      pending.pop_front();
+  // The topology stage's queue is the one place a closed place waits for its step. Bounded: when it is
+  // full, the oldest step is finished now, whatever the frame's budget (the frames behind wait, and a
+  // drop-oldest queue drops their estimates, counted); counted as a kept wait. Places are never dropped.
+  auto enqueueBounded = [&](FrameResult& r, ClosedPlace place) {
+    if (topology_.queuedPlaces() >= kPlaceQueueCapacity) {
+      place_queue_kept_waits_.fetch_add(1);
+      if (place_queue_full++ % 100 == 0)
+        spdlog::warn("pipeline: the topology filter is {} places behind; finishing the oldest step now ({} times "
+                     "so far)", topology_.queuedPlaces(), place_queue_full);
+      while (topology_.queuedPlaces() >= kPlaceQueueCapacity)
+        if (std::optional<FinishedPlace> done = topology_.advance(1e9))
+          r.finished_places.push_back(std::move(*done));
     }
-    place.place = assignment.place;
-    r.finished_places.emplace_back(std::move(place), assignment);
+    topology_.enqueuePlace(std::move(place));
+    place_queue_high_water_.store(std::max(place_queue_high_water_.load(), topology_.queuedPlaces()));
   };
   auto stampEstimate = [&](FrameResult& r) {
     r.estimate = topology_.estimate();
@@ -434,8 +434,7 @@ void Pipeline::topologyLoop() {
       if (wait == QueueWait::Item) {
         const double t0 = clock_.now();
         if (r.closed_place) {
-          topology_.enqueuePlace(*r.closed_place);
-          pending.push_back(std::move(*r.closed_place));
+          enqueueBounded(r, std::move(*r.closed_place));
           r.closed_place.reset();
           places_.fetch_add(1);
         }
@@ -444,7 +443,8 @@ void Pipeline::topologyLoop() {
         while (!topology_.idle()) {
           const double remaining = deadline - clock_.now();
           if (remaining <= 0.0) break;
-          if (std::optional<PlaceAssignment> done = topology_.advance(remaining)) attach(r, *done);
+          if (std::optional<FinishedPlace> done = topology_.advance(remaining))
+            r.finished_places.push_back(std::move(*done));
         }
         stampEstimate(r);
         r.filter_ms = (clock_.now() - t0) * 1e3;
@@ -464,7 +464,8 @@ void Pipeline::topologyLoop() {
     FrameResult flush;
     flush.has_frame = false;
     while (!topology_.idle())
-      if (std::optional<PlaceAssignment> done = topology_.advance(1e9)) attach(flush, *done);
+      if (std::optional<FinishedPlace> done = topology_.advance(1e9))
+        flush.finished_places.push_back(std::move(*done));
     stampEstimate(flush);
     if (!flush.finished_places.empty() || flush.topology) results_->pushWait(std::move(flush));
   } catch (const std::exception& e) {
@@ -504,6 +505,7 @@ StatusCounters Pipeline::statusCounters(std::int64_t published) const {
   c.source_reconnect_attempts = source_reconnect_attempts_.load();
   c.source_dropped = source_dropped_.load();
   c.places = places_.load();
+  c.place_queue_kept_waits = place_queue_kept_waits_.load();
   c.map_revision = map_revision_.load();
   c.maps_saved = maps_saved_.load();
   return c;

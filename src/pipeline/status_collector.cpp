@@ -79,6 +79,7 @@ PipelineStatus StatusCollector::collect(double now_s, const std::string& state, 
     s.queue_kept_waits += stage.input.kept_waits;
     s.stages.push_back(std::move(st));
   }
+  s.queue_kept_waits += counters.place_queue_kept_waits;
   s.cpu_percent = 100.0 * (counters.process_cpu_s - period_cpu_start_s_) / elapsed;
   s.places = counters.places;
   s.map_revision = counters.map_revision;

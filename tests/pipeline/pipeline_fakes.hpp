@@ -4,9 +4,11 @@
 // needs no wall clock).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -111,13 +113,15 @@ class AbsentCameraSource final : public FrameSource {
 
 class FakeFingerprint final : public FingerprintStage {
  public:
-  Fingerprint process(const cv::Mat& image, const cv::Mat& /*grey*/) override {
+  FingerprintedFrame process(const cv::Mat& image, const cv::Mat& /*grey*/) override {
     const int value = image.at<cv::Vec3b>(0, 0)[0];
     if (on_process) on_process(value);
     if (throw_when && throw_when(value)) throw std::invalid_argument("unreadable frame");
-    Fingerprint f;
-    f.image_width = image.cols;
-    f.image_height = image.rows;
+    FingerprintedFrame f;
+    f.fingerprint.image_width = image.cols;
+    f.fingerprint.image_height = image.rows;
+    // A 2x1 thumbnail whose pixels say which frame it was made of (sequence % 256).
+    f.thumbnail = cv::Mat(1, 2, CV_8UC3, cv::Scalar::all(static_cast<double>(value)));
     return f;
   }
   std::function<void(int)> on_process;   ///< argument: the frame's pixel value (sequence % 256)
@@ -174,28 +178,33 @@ class FakeTopology final : public TopologyStage {
  public:
   FakeTopology(ManualClock& clock, int slices_per_step, double slice_s)
       : clock_(clock), slices_per_step_(slices_per_step), slice_s_(slice_s) {}
-  void enqueuePlace(const ClosedPlace& place) override { queue_.push_back(place.place); }
-  std::optional<PlaceAssignment> advance(double budget_s) override {
+  void enqueuePlace(ClosedPlace place) override {
+    queue_.push_back(std::move(place));
+    most_queued = std::max(most_queued, queue_.size());
+  }
+  std::optional<FinishedPlace> advance(double budget_s) override {
     const double deadline = clock_.now() + budget_s;
     do {
       if (queue_.empty()) return std::nullopt;
       clock_.advance(slice_s_);  // one slice of work costs slice_s of (manual) time
       if (++done_slices_ == slices_per_step_) {
         done_slices_ = 0;
-        const int place = queue_.front();
-        queue_.erase(queue_.begin());
+        FinishedPlace done{std::move(queue_.front()), PlaceAssignment{}};
+        queue_.pop_front();
+        const int place = done.place.place;
         ++revision_;
         estimate_.place = place;
         estimate_.node = place % 3;  // a loop of three rooms
         estimate_.is_new = place < 3;
         estimate_.probability = 0.9;
         estimate_.map_revision = revision_;
-        PlaceAssignment a{place, estimate_.node, estimate_.is_new, 0.9};
-        return a;
+        done.assignment = PlaceAssignment{place, estimate_.node, estimate_.is_new, 0.9};
+        return done;
       }
     } while (clock_.now() < deadline);
     return std::nullopt;
   }
+  std::size_t queuedPlaces() const override { return queue_.size(); }
   bool idle() const override { return queue_.empty(); }
   const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override {
@@ -226,6 +235,7 @@ class FakeTopology final : public TopologyStage {
     return std::make_unique<Snapshot>(*this, idle(), revision_);
   }
   std::function<void()> on_write;  ///< called on the map writer thread before each write (e.g. a slow disk)
+  std::size_t most_queued = 0;     ///< most places queued at once (topology thread; read after wait())
   mutable std::mutex saves_mutex;
   mutable std::vector<std::string> saves;
   mutable std::vector<bool> saved_while_idle;
@@ -235,7 +245,7 @@ class FakeTopology final : public TopologyStage {
   ManualClock& clock_;
   int slices_per_step_;
   double slice_s_;
-  std::vector<int> queue_;
+  std::deque<ClosedPlace> queue_;
   int done_slices_ = 0;
   std::int64_t revision_ = 0;
   PlaceEstimate estimate_;

@@ -83,6 +83,18 @@ SCENARIO("The filter step of a place is spread over the following frames within 
       for (const FrameResult& r : sink.results)
         if (r.has_frame) CHECK(r.filter_ms <= 2.0 + 1e-6);
     }
+    THEN("each place carries the thumbnail the fingerprint stage made of the frame that closed it") {
+      int with_thumbnail = 0;
+      for (const FrameResult& r : sink.results)
+        for (const auto& [place, assignment] : r.finished_places) {
+          if (assignment.place == 9) continue;  // closed by the end of the stream: no frame, no thumbnail
+          REQUIRE(place.thumbnail.size() == cv::Size(2, 1));
+          // FakeFingerprint paints its thumbnail with the frame's value (sequence % 256).
+          CHECK(place.thumbnail.at<cv::Vec3b>(0, 1)[0] == 10 * assignment.place + 9);
+          ++with_thumbnail;
+        }
+      CHECK(with_thumbnail == 9);
+    }
     THEN("the estimate of frame 11 is place 0 on node 0, and frame 41 sees the loop close (place 3 -> node 0)") {
       CHECK(sink.results[11].estimate.place == 0);
       CHECK(sink.results[10].estimate.place == -1);
@@ -109,6 +121,53 @@ SCENARIO("The filter step of a place is spread over the following frames within 
       CHECK(s.stages[1].name == "fingerprint");
       CHECK(s.stages[1].processed == 100);
       CHECK(s.stages[3].processed == 100);
+    }
+  }
+}
+
+SCENARIO("GIVEN a filter far slower than the places WHEN they close THEN they wait in one bounded place "
+         "queue, counted, and none is lost") {
+  GIVEN("40 frames, a place closing on every frame, a step of 100 slices of 1 ms, a budget of 2 ms a frame") {
+    ManualClock clock;
+    FakeSource source(40);
+    FakeFingerprint fingerprint;
+    FakeSegmentation segmentation(1);
+    FakeTopology topology(clock, 100, 1e-3);
+    RecordingSink sink;
+    std::size_t high_water = 0;
+    {
+      Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                        topology, sink, clock);
+      pipeline.start();
+      pipeline.wait();
+      REQUIRE(pipeline.error().empty());
+      high_water = pipeline.placeQueueHighWater();
+    }
+    THEN("the queue holds at most 16 places: from frame 16 on, a new place first finishes the oldest step") {
+      REQUIRE(Pipeline::kPlaceQueueCapacity == 16);
+      CHECK(topology.most_queued == 16);
+      CHECK(high_water == 16);
+      std::vector<std::int64_t> frame_of_place(40, -2);
+      for (const FrameResult& r : sink.results)
+        for (const auto& [place, assignment] : r.finished_places)
+          frame_of_place[static_cast<std::size_t>(assignment.place)] = r.has_frame ? r.sequence : -1;
+      for (int p = 0; p < 24; ++p) CHECK(frame_of_place[static_cast<std::size_t>(p)] == p + 16);
+      for (int p = 24; p < 40; ++p) CHECK(frame_of_place[static_cast<std::size_t>(p)] == -1);  // at the end
+      REQUIRE_FALSE(sink.statuses.empty());
+      CHECK(sink.statuses.back().queue_kept_waits == 24);
+      CHECK(sink.statuses.back().places == 40);
+    }
+    THEN("every place comes out once, in order, as the segmentation closed it (its thumbnail)") {
+      std::vector<int> places;
+      for (const FrameResult& r : sink.results)
+        for (const auto& [place, assignment] : r.finished_places) {
+          places.push_back(assignment.place);
+          CHECK(place.place == assignment.place);
+          REQUIRE(place.thumbnail.size() == cv::Size(2, 1));
+          CHECK(place.thumbnail.at<cv::Vec3b>(0, 0)[0] == assignment.place);  // closed by frame == place
+        }
+      REQUIRE(places.size() == 40);
+      for (int p = 0; p < 40; ++p) CHECK(places[static_cast<std::size_t>(p)] == p);
     }
   }
 }

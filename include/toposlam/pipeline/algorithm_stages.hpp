@@ -31,9 +31,12 @@ class WorkerPool;
 // FiedlerSegmenterConfig, TopologyFilterConfig). DaemonConfig holds one of each; the key table
 // (config_keys.cpp) gives each member its key, default and range.
 
-/// fingerprint.*: how the fingerprint stage runs VPACK.
+/// fingerprint.*: how the fingerprint stage runs VPACK, and the thumbnail it makes.
 struct FingerprintStageConfig {
   int workers = 2;  ///< fingerprint.workers: WorkerPool threads incl. the fingerprint thread, 1 .. 64
+  /// pipeline.thumbnail_width (its key from before the stage made thumbnails): the place-event thumbnail's
+  /// width in pixels, 16 .. 1280; the height keeps the aspect.
+  int thumbnail_width = 160;
 };
 
 /// segmentation.*: what the segmentation stage adds to the segmenter.
@@ -47,16 +50,22 @@ struct TopologyStageConfig {
   int alternatives = 3;   ///< topology.alternatives: other nodes published per frame, 0 .. 16
 };
 
-/// VPACK extraction; the per-subregion work runs on `pool` (borrowed; null = inline).
+/// VPACK extraction, and the frame's thumbnail for the place events: the frame shrunk to
+/// `thumbnail_width` pixels (never enlarged; the height keeps the aspect, at least 1) by pixel-area
+/// averaging (cv::INTER_AREA). The per-subregion work runs on `pool` (borrowed; null = inline).
 class VpackFingerprintStage final : public FingerprintStage {
  public:
-  VpackFingerprintStage(const VpackConfig& config, WorkerPool* pool) : extractor_(config, pool) {}
-  Fingerprint process(const cv::Mat& image, const cv::Mat& grey) override {
-    return extractor_.extract(image, grey);
-  }
+  /// No thumbnail: the offline commands, which publish no place events.
+  static constexpr int kNoThumbnail = 0;
+  /// `thumbnail_width`: FingerprintStageConfig::thumbnail_width, or kNoThumbnail.
+  VpackFingerprintStage(const VpackConfig& config, WorkerPool* pool, int thumbnail_width = kNoThumbnail)
+      : extractor_(config, pool), thumbnail_width_(thumbnail_width) {}
+  /// Throws std::invalid_argument for images the extractor refuses.
+  FingerprintedFrame process(const cv::Mat& image, const cv::Mat& grey) override;
 
  private:
   VpackExtractor extractor_;
+  int thumbnail_width_;
 };
 
 /// One robot motion sample for the segmentation stage (from TOPOSLAM_MOTION's motion_t).
@@ -185,8 +194,9 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   }
   std::int64_t lastMappedFrame() const { return last_mapped_frame_; }
 
-  void enqueuePlace(const ClosedPlace& place) override;
-  std::optional<PlaceAssignment> advance(double budget_s) override;
+  void enqueuePlace(ClosedPlace place) override;
+  std::optional<FinishedPlace> advance(double budget_s) override;
+  std::size_t queuedPlaces() const override { return queue_.size(); }
   bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
   const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override { return topology_; }
@@ -206,14 +216,8 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   int alternatives_;
   CandidateSelectionConfig candidates_;  ///< re-applied to a loaded map
   std::unique_ptr<TopologyParticleFilter> filter_;
-  /// A closed place waiting for (or in) its filter step: the front one while a step is in progress.
-  struct QueuedPlace {
-    std::shared_ptr<const Fingerprint> representative;
-    std::int64_t representative_frame = -1;
-    std::int64_t last_frame = -1;
-    std::vector<double> evidence;  ///< by earlier place of this run (ClosedPlace::evidence)
-  };
-  std::deque<QueuedPlace> queue_;
+  /// Closed places waiting for (or in) their filter step: the front one while a step is in progress.
+  std::deque<ClosedPlace> queue_;
   std::vector<std::int64_t> representative_frames_;  ///< per observation (-1: from an older run)
   std::function<std::string(std::int64_t)> name_of_;
   std::int64_t last_mapped_frame_ = -1;  ///< the last frame of the last place stepped (or of the resumed map)

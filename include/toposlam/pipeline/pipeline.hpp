@@ -1,18 +1,19 @@
 // The real-time pipeline: five named stage threads and a map writer, created at start and joined at stop,
 //
 //   capture --q--> fingerprint --q--> segmentation --q--> topology --q--> publisher
+//                                                         (places q)
 //                                                            `--snapshot--> map writer
 //
 // connected by BoundedQueues. When a stage falls behind, its input queue drops the OLDEST per-frame item
 // and counts it (overflow: drop_oldest, the real-time default), or the producer waits (overflow: block,
 // for lossless replay of files). Records that carry a place (a closed place, a finished step, a new
 // topology) are never dropped. Frames are not copied: the capture queue carries the source's Frame (its
-// buffer_lease keeps the driver buffer); the fingerprint thread releases it as soon as the fingerprint and
-// a small thumbnail are made. The topology filter's step for a place is spread over the following frames:
-// per frame the topology thread spends at most `filter_budget_ms` in TopologyStage::advance(). A status is
-// published every `status_period_s`. The map is saved atomically every `MapConfig::save_period_s` and at
-// stop: the topology thread takes an in-memory snapshot, the map writer thread writes it (fsync off the
-// frame path).
+// buffer_lease keeps the driver buffer); the fingerprint thread releases it as soon as the fingerprint
+// stage has made the fingerprint and a small thumbnail (FingerprintedFrame). The topology filter's step for
+// a place is spread over the following frames: per frame the topology thread spends at most
+// `filter_budget_ms` in TopologyStage::advance(). A status is published every `status_period_s`. The map
+// is saved atomically every `MapConfig::save_period_s` and at stop: the topology thread takes an in-memory
+// snapshot, the map writer thread writes it (fsync off the frame path).
 //
 // The capture thread reads the source with a bounded wait (FrameSource::nextFor), so it keeps beating
 // while a camera is silent or reconnecting: that is healthy, and the status says "reconnecting". A stage
@@ -78,7 +79,6 @@ struct PipelineConfig {
   PipelineThreads threads;
   double filter_budget_ms = 5.0;     ///< topology work per frame, milliseconds (0.1 .. 1000)
   double status_period_s = 1.0;      ///< status message period (0.1 .. 60)
-  int thumbnail_width = 160;         ///< place-event thumbnail width in pixels (16 .. 1280), height keeps aspect
   bool record_latencies = false;     ///< keep every frame's capture-to-publish latency (benchmark)
   /// OpenCV's own thread pool, set at start (cv::setNumThreads, process-wide). 1: OpenCV runs each call
   /// on the calling stage thread, so the only threads are the table's and the fingerprint workers
@@ -159,6 +159,14 @@ class Pipeline {
   /// What a full queue does in this run: queues.overflow with Auto resolved for the source.
   QueueOverflow overflow() const { return config_.queues.overflow; }
 
+  /// Places that may wait in the topology stage's queue (TopologyStage::queuedPlaces, the one in its step
+  /// included). A place closed when it is full first has the oldest step finished, beyond the frame's
+  /// budget (a kept wait, PipelineStatus::queue_kept_waits): the filter may fall behind by this many places,
+  /// no more; places are never dropped.
+  static constexpr std::size_t kPlaceQueueCapacity = 16;
+  /// Most places the topology stage's queue held at once (any thread).
+  std::size_t placeQueueHighWater() const { return place_queue_high_water_.load(); }
+
  private:
   struct CapturedFrame;
   struct Fingerprinted;
@@ -213,6 +221,8 @@ class Pipeline {
   std::atomic<double> thread_cpu_s_[kThreadCount] = {};  ///< CPU time of each stage thread so far
   std::atomic<std::int64_t> maps_saved_{0};
   std::atomic<int> places_{0};
+  std::atomic<std::int64_t> place_queue_kept_waits_{0};  ///< the place queue was full (topology thread)
+  std::atomic<std::size_t> place_queue_high_water_{0};
   // Copied by their owning thread so the publisher never calls into another thread's stage or source.
   std::atomic<std::int64_t> map_revision_{0};
   std::atomic<std::int64_t> source_skipped_{0};

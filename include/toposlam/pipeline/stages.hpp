@@ -50,6 +50,14 @@ struct PlaceAssignment {
   double probability = 0.0;      ///< probability of this node for this place (over particles)
 };
 
+/// A place whose filter step finished: the closed place as the segmentation stage gave it (thumbnail,
+/// frames, representative), numbered by the filter (ClosedPlace::place = PlaceAssignment::place, the
+/// filter's observation, which goes on from a resumed map), and the filter's decision.
+struct FinishedPlace {
+  ClosedPlace place;
+  PlaceAssignment assignment;
+};
+
 struct NodeProbability {
   int node = -1;
   double probability = 0.0;
@@ -88,13 +96,22 @@ struct TopologySnapshot {
 
 // ---------------------------------------------------------------------------------------------------
 
-/// Frame -> fingerprint. Must not keep a reference to the frame's pixels after returning: the
-/// frame's buffer goes back to the source right after.
+/// What the fingerprint stage makes of one frame: everything later stages need of its pixels, so the
+/// frame's buffer can go back to the source.
+struct FingerprintedFrame {
+  Fingerprint fingerprint;
+  /// Small copy of the frame (BGR, or grey as the frame) for the place event of the place it may end up
+  /// representing; empty when the stage makes none.
+  cv::Mat thumbnail;
+};
+
+/// Frame -> fingerprint and thumbnail. Must not keep a reference to the frame's pixels after returning:
+/// the frame's buffer goes back to the source right after (the thumbnail is a copy).
 class FingerprintStage {
  public:
   virtual ~FingerprintStage() = default;
   /// image: the frame (BGR, or grey); grey: the camera's own grey of it, or empty (Frame::grey).
-  virtual Fingerprint process(const cv::Mat& image, const cv::Mat& grey) = 0;
+  virtual FingerprintedFrame process(const cv::Mat& image, const cv::Mat& grey) = 0;
 };
 
 /// Fingerprint -> Fiedler value and, now and then, a closed place. Called for every frame, in order.
@@ -126,15 +143,19 @@ class MapSnapshot {
   virtual std::size_t bytes() const = 0;
 };
 
-/// The topology filter, with its per-place step split into bounded slices of work.
+/// The topology filter, with its per-place step split into bounded slices of work. The stage's queue of
+/// places is the one place a closed place waits for its step: it keeps the whole ClosedPlace and hands it
+/// back with the filter's decision (the Pipeline bounds it, Pipeline::kPlaceQueueCapacity).
 class TopologyStage {
  public:
   virtual ~TopologyStage() = default;
-  /// Queues the filter step for a newly closed place (places arrive in order).
-  virtual void enqueuePlace(const ClosedPlace& place) = 0;
+  /// Queues the filter step for a newly closed place (places arrive in order); the stage keeps the place.
+  virtual void enqueuePlace(ClosedPlace place) = 0;
   /// Works on the queued steps for about `budget_s` seconds (it may overrun by one slice of work).
-  /// Returns the assignment when a place's step finished during this call (at most one per call).
-  virtual std::optional<PlaceAssignment> advance(double budget_s) = 0;
+  /// Returns the place and its assignment when its step finished during this call (at most one per call).
+  virtual std::optional<FinishedPlace> advance(double budget_s) = 0;
+  /// Places queued, the one in its step included.
+  virtual std::size_t queuedPlaces() const = 0;
   /// True when no step is queued or in progress.
   virtual bool idle() const = 0;
   /// The estimate as of the last finished step (valid until the next advance() or map load; read on
@@ -194,7 +215,9 @@ struct PipelineStatus {
   std::int64_t frames_captured = 0;
   std::int64_t frames_published = 0;
   std::int64_t frames_dropped = 0;   ///< all queues together (only per-frame estimates; places are kept)
-  std::int64_t queue_kept_waits = 0; ///< all queues together: a producer waited, the queue held only places
+  /// All queues together: a producer waited, the queue held only places (the topology stage's place
+  /// queue included: full, its oldest step was finished first, Pipeline::kPlaceQueueCapacity).
+  std::int64_t queue_kept_waits = 0;
   std::int64_t source_skipped = 0;   ///< bad frames the source skipped
   SourceLink source_link = SourceLink::Streaming;  ///< the camera: streaming or reconnecting
   std::int64_t source_reconnects = 0;              ///< camera outages survived
@@ -221,7 +244,7 @@ struct FrameResult {
   double lambda2 = std::numeric_limits<double>::quiet_NaN();
   std::optional<ClosedPlace> closed_place;  ///< closed by segmentation on this frame (its step is queued)
   PlaceEstimate estimate;
-  std::vector<std::pair<ClosedPlace, PlaceAssignment>> finished_places;  ///< steps finished on this frame
+  std::vector<FinishedPlace> finished_places;  ///< steps finished on this frame
   std::shared_ptr<const TopologySnapshot> topology;  ///< set when the topology changed on this frame
 };
 

@@ -35,6 +35,7 @@ struct StatusCounters {
   int source_reconnect_attempts = 0;
   std::int64_t source_dropped = 0;
   int places = 0;
+  std::int64_t place_queue_kept_waits = 0;  ///< the topology stage's place queue was full
   std::int64_t map_revision = 0;
   std::int64_t maps_saved = 0;
 };

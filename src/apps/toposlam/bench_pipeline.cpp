@@ -184,7 +184,7 @@ RunResult runOnce(const DaemonConfig& base, const PipelineBenchOptions& o, const
     RecordingSink sink(lcm);
     LoopedFrameSource source(images, o.source_fps, o.frames, paced ? o.rate : 0.0);
     WorkerPool pool(c.fingerprint_stage.workers, namedWorkers("tsl-vpack"));
-    VpackFingerprintStage fingerprint(c.fingerprint, &pool);
+    VpackFingerprintStage fingerprint(c.fingerprint, &pool, c.fingerprint_stage.thumbnail_width);
     NgramSimilarity similarity(c.similarity);
     FiedlerSegmentationStage segmentation(c.segmentation, similarity, 600, c.segmentation_stage.motion);
     ParticleFilterTopologyStage topology(c.topology, similarity, clock, c.topology_stage);

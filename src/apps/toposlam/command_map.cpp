@@ -138,116 +138,154 @@ std::string shellQuote(const std::string& text) {
   return out + "'";
 }
 
-void runMap(const MapOptions& o, bool filter_options_given) {
-  if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
-  FiedlerSegmenterConfig segmenter_config = segmenterConfig(o.segmentation, "map");
-  std::optional<MotionReplay> motion = openMotion(o.motion, o.sources.size(), "map", segmenter_config);
-  const fs::path out_dir(o.out);
-  createRunFolder(o.out);
-  // The run folder's map.tsm is ours until the end: a second `map` (or a toposlamd) on it is refused
-  // before any work, and temporaries a killed run left there are removed.
-  const fs::path map_path = out_dir / "map.tsm";
-  const MapLock map_lock = MapLock::acquire(map_path);
+/// The run folder's map.tsm is ours until the end: a second `map` (or a toposlamd) on it is refused before
+/// any work, and temporaries a killed run left there are removed.
+MapLock lockRunFolderMap(const fs::path& map_path, const std::string& out) {
+  MapLock lock = MapLock::acquire(map_path);
   if (const int orphans = MapStore::removeOrphanedTemporaries(map_path); orphans > 0)
-    std::cerr << "map: removed " << orphans << " temporary files of an interrupted save in " << o.out << "\n";
+    std::cerr << "map: removed " << orphans << " temporary files of an interrupted save in " << out << "\n";
+  return lock;
+}
 
-  const MethodPreset preset = presetOf(o.segmentation, "map");
+/// The preset's VPACK settings with --keypoints and --max-keypoints.
+VpackConfig fingerprintConfig(const MapOptions& o, const MethodPreset& preset) {
   VpackConfig vpack = preset.fingerprint;
   vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
   if (o.max_keypoints >= 0) vpack.keypoints.setMaxKeypoints(o.max_keypoints);
-  VpackFingerprintStage fingerprint_stage(vpack, nullptr);
+  return vpack;
+}
+
+/// How frame-level loop closures are found (docs/topology.md): by sequence or by visits to a node.
+struct FrameLoopPlan {
+  bool by_sequence = true;
+  SequenceLoopConfig sequence_loops;  ///< with min_gap_keyframes from --loop-min-gap-s
+};
+
+FrameLoopPlan frameLoopPlan(const MapOptions& o, const MethodPreset& preset) {
+  FrameLoopPlan plan;
   // The thesis has no frame-level detector of its own: its preset reads frame closures off the topology.
-  const bool by_sequence =
-      o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
-  SequenceLoopConfig sequence_loops = o.sequence_loops;
-  sequence_loops.min_gap_keyframes = std::max(
-      1, static_cast<int>(std::lround(o.loop_min_gap_s / std::max(sequence_loops.keyframe_interval_s, 1e-9))));
-  if (const std::string problem = sequence_loops.validate(); !problem.empty())
+  plan.by_sequence = o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
+  plan.sequence_loops = o.sequence_loops;
+  const double keyframe_interval_s = std::max(plan.sequence_loops.keyframe_interval_s, 1e-9);
+  plan.sequence_loops.min_gap_keyframes =
+      std::max(1, static_cast<int>(std::lround(o.loop_min_gap_s / keyframe_interval_s)));
+  if (const std::string problem = plan.sequence_loops.validate(); !problem.empty())
     throw std::invalid_argument("map: " + problem);
-  NgramSimilarityConfig similarity_config = preset.similarity;
-  if (o.histogram_weight >= 0) similarity_config.histogram_weight = o.histogram_weight;
-  if (o.histogram_gate >= 0) similarity_config.histogram_gate = o.histogram_gate == 1;
-  const NgramSimilarity similarity(similarity_config);
+  return plan;
+}
 
-  // The filter steps run to their end before the next frame, so the budget's clock is never read for a
-  // decision (ParticleFilterTopologyStage::advance with an infinite budget).
-  const ManualClock clock;
-  TopologyStageConfig topology_stage;
+/// The preset's similarity with --histogram-weight and --histogram-gate.
+NgramSimilarityConfig similarityConfig(const MapOptions& o, const MethodPreset& preset) {
+  NgramSimilarityConfig config = preset.similarity;
+  if (o.histogram_weight >= 0) config.histogram_weight = o.histogram_weight;
+  if (o.histogram_gate >= 0) config.histogram_gate = o.histogram_gate == 1;
+  return config;
+}
+
+/// The topology stage the run starts from: a new filter, or the one of the map given to --resume with the
+/// origins of its observations.
+struct StartingFilter {
   std::unique_ptr<ParticleFilterTopologyStage> topology;
-  std::vector<ObservationOrigin> origins;
-  int run_number = 0;
-  if (!o.resume.empty()) {
-    if (filter_options_given) {
-      throw std::invalid_argument(
-          "map: --particles, --alpha, --seed and --max-representatives come from the map "
-          "when resuming; drop them or start a new map");
-    }
-    LoadedMap loaded = MapStore::load(o.resume, similarity);
-    // ORB descriptors mean nothing to a SIFT run (and so on), and another source (a simulated office, a
-    // camera elsewhere) is no continuation unless the user says so: the map says what it was made with.
-    for (const std::string& uri : o.sources) {
-      MapSettings current = fingerprintMapSettings(vpack);
-      current[kMapSourceKey] = sourceIdentity(uri);
-      std::string hint;
-      if (settingDiffers(loaded.settings, current, "keypoints")) hint += "--keypoints";
-      if (o.resume_other_source)
-        current.erase(kMapSourceKey);
-      else if (settingDiffers(loaded.settings, current, kMapSourceKey))
-        hint += std::string(hint.empty() ? "" : "; ") + "--resume-other-source continues it from this source";
-      if (const std::string refusal = MapStore::checkSettings(loaded.settings, current, o.resume); !refusal.empty())
-        throw ConfigError("map: " + refusal + " (" + hint + ")");
-    }
-    TopologyFilterConfig config = loaded.filter->config();
-    config.candidates = o.candidates;  // how this run compares, not saved with the map (adoptMap applies it)
-    topology = std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, topology_stage);
-    origins = decodeOrigins(loaded.application_data, loaded.filter->observationCount());
-    topology->adoptMap(std::move(loaded));
-    for (const auto& origin : origins) run_number = std::max(run_number, origin.run + 1);
-    std::cerr << "map: resumed " << o.resume << " (" << topology->observations() << " places)\n";
-  } else {
-    TopologyFilterConfig config = preset.topology;
-    config.particles = o.particles;
-    config.alpha = o.alpha;
-    config.seed = o.seed;
-    config.max_representatives_per_node = o.max_representatives;
-    if (o.likelihood_given->count() > 0) config.likelihood = parseLikelihoodModel(o.likelihood);
-    if (o.slope_given->count() > 0) config.relative_slope = o.relative_slope;
-    if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
-    if (o.entropy_given->count() > 0) config.new_node_entropy = o.new_node_entropy;
-    if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
-    config.candidates = o.candidates;
-    if (const std::string problem = config.validate(); !problem.empty())
-      throw std::invalid_argument("map: " + problem);
-    topology = std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, topology_stage);
-  }
-  const TopologyParticleFilter& filter = topology->filter();
-  const int first_observation = filter.observationCount();
+  std::vector<ObservationOrigin> origins;  ///< per observation so far (the resumed map's)
+  int run_number = 0;                      ///< this run's, in the origins
+};
 
+/// --resume: the saved map, refused (ConfigError naming the option that would accept it) when it was made
+/// with other keypoints or from another source.
+StartingFilter resumedFilter(const MapOptions& o, const VpackConfig& vpack, const NgramSimilarity& similarity,
+                             const Clock& clock, bool filter_options_given) {
+  if (filter_options_given) {
+    throw std::invalid_argument(
+        "map: --particles, --alpha, --seed and --max-representatives come from the map "
+        "when resuming; drop them or start a new map");
+  }
+  LoadedMap loaded = MapStore::load(o.resume, similarity);
+  // ORB descriptors mean nothing to a SIFT run (and so on), and another source (a simulated office, a
+  // camera elsewhere) is no continuation unless the user says so: the map says what it was made with.
+  for (const std::string& uri : o.sources) {
+    MapSettings current = fingerprintMapSettings(vpack);
+    current[kMapSourceKey] = sourceIdentity(uri);
+    std::string hint;
+    if (settingDiffers(loaded.settings, current, "keypoints")) hint += "--keypoints";
+    if (o.resume_other_source)
+      current.erase(kMapSourceKey);
+    else if (settingDiffers(loaded.settings, current, kMapSourceKey))
+      hint += std::string(hint.empty() ? "" : "; ") + "--resume-other-source continues it from this source";
+    const std::string refusal = MapStore::checkSettings(loaded.settings, current, o.resume);
+    if (!refusal.empty()) throw ConfigError("map: " + refusal + " (" + hint + ")");
+  }
+  TopologyFilterConfig config = loaded.filter->config();
+  config.candidates = o.candidates;  // how this run compares, not saved with the map (adoptMap applies it)
+  StartingFilter start;
+  start.topology =
+      std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, TopologyStageConfig{});
+  start.origins = decodeOrigins(loaded.application_data, loaded.filter->observationCount());
+  start.topology->adoptMap(std::move(loaded));
+  for (const auto& origin : start.origins) start.run_number = std::max(start.run_number, origin.run + 1);
+  std::cerr << "map: resumed " << o.resume << " (" << start.topology->observations() << " places)\n";
+  return start;
+}
+
+/// A new filter: the preset's, with the filter options given.
+StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const NgramSimilarity& similarity,
+                         const Clock& clock) {
+  TopologyFilterConfig config = preset.topology;
+  config.particles = o.particles;
+  config.alpha = o.alpha;
+  config.seed = o.seed;
+  config.max_representatives_per_node = o.max_representatives;
+  if (o.likelihood_given->count() > 0) config.likelihood = parseLikelihoodModel(o.likelihood);
+  if (o.slope_given->count() > 0) config.relative_slope = o.relative_slope;
+  if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
+  if (o.entropy_given->count() > 0) config.new_node_entropy = o.new_node_entropy;
+  if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
+  config.candidates = o.candidates;
+  if (const std::string problem = config.validate(); !problem.empty())
+    throw std::invalid_argument("map: " + problem);
+  StartingFilter start;
+  start.topology =
+      std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, TopologyStageConfig{});
+  return start;
+}
+
+/// The filter's sequence evidence (docs/topology.md) from the --sequence-evidence options.
+SequenceEvidenceConfig sequenceEvidenceConfig(const MapOptions& o, const SequenceLoopConfig& sequence_loops) {
   SequenceEvidenceConfig evidence;
   evidence.loop = sequence_loops;
   evidence.weight = o.sequence_evidence;
   evidence.min_score = o.sequence_evidence_min_score;
   evidence.min_relative = o.sequence_evidence_min_relative;
   evidence.min_share = o.sequence_evidence_min_share;
-  if (const std::string problem = evidence.validate(); !problem.empty()) throw std::invalid_argument("map: " + problem);
-  // Thumbnails are the daemon's (place events); the offline run keeps none.
-  FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
-  OfflineRunner runner(fingerprint_stage, segmentation_stage, topology.get());
-  std::vector<TimingRow> timing;
-  std::int64_t refused = 0;
-  // Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
-  std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
+  if (const std::string problem = evidence.validate(); !problem.empty())
+    throw std::invalid_argument("map: " + problem);
+  return evidence;
+}
 
+/// What the sources' traversals leave besides the runner's rows.
+struct Traversals {
+  std::vector<TimingRow> timing;  ///< per segmented frame
+  std::int64_t refused = 0;       ///< frames the extractor refused
+  /// Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
+  std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
+};
+
+/// Every source, one traversal after the other, through the runner: fingerprint, segment, and a filter step
+/// for every kept place; `origins` gets one entry per step.
+Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
+                           FiedlerSegmentationStage& segmentation_stage, std::optional<MotionReplay>& motion,
+                           std::vector<ObservationOrigin>& origins, int run_number) {
+  Traversals done;
   Progress* progress = nullptr;  // the current source's progress line (cleared before a log line)
   auto mapPlace = [&](const SegmentedPlace& place) {
     if (place.dropped) return;
     if (progress != nullptr) progress->clearLine();
     const auto start = std::chrono::steady_clock::now();
     const MappedPlace mapped = *runner.mapPlace(place);
-    if (!timing.empty()) timing.back().filter_ms = *timing.back().filter_ms + msSince(start);
+    if (!done.timing.empty()) done.timing.back().filter_ms = *done.timing.back().filter_ms + msSince(start);
     origins.push_back(ObservationOrigin{run_number, place.representative_frame});
     const TopologyEstimate& e = mapped.estimate;
-    std::fprintf(stderr, "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
+    std::fprintf(stderr,
+                 "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
                  static_cast<long long>(place.index), static_cast<long long>(place.first_frame),
                  static_cast<long long>(place.last_frame), e.current_node, e.current_node_probability,
                  e.best.probability, e.effective_sample_size);
@@ -266,7 +304,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     while (std::optional<Frame> frame = source->next()) {
       source_progress.update(++read);
       TimingRow t;
-      t.frame = static_cast<std::int64_t>(timing.size());
+      t.frame = static_cast<std::int64_t>(done.timing.size());
       t.filter_ms = 0.0;
       auto start = std::chrono::steady_clock::now();
       std::shared_ptr<const Fingerprint> fingerprint;
@@ -274,19 +312,20 @@ void runMap(const MapOptions& o, bool filter_options_given) {
         fingerprint = runner.fingerprint(frame->image, frame->grey);
       } catch (const std::invalid_argument& e) {
         // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
-        if (refused++ == 0) std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
+        if (done.refused++ == 0)
+          std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
         continue;
       }
       t.fingerprint_ms = msSince(start);
       start = std::chrono::steady_clock::now();
-      frame_fingerprints.push_back(fingerprint);
+      done.frame_fingerprints.push_back(fingerprint);
       // With several sources, names carry their source's folder ("ref/0001.jpg", "query/0001.jpg") so
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
       if (motion) motion->feedUpTo(frame->timestamp_s, segmentation_stage);
       const SegmenterStep step = runner.segment(frame->timestamp_s, name, std::move(fingerprint));
       t.segment_ms = msSince(start);
-      timing.push_back(t);
+      done.timing.push_back(t);
       frame.reset();  // hand the buffer back to the source
       if (step.closed_place) mapPlace(*step.closed_place);
     }
@@ -298,110 +337,108 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     if (const FrameTimeline& timeline = segmentation_stage.sourceTimeline(); timeline.stepsBack() > 0)
       std::cerr << timelineSummary(timeline, "map") << "\n";
   }
-  if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
-  const SegmentationRun& all = runner.run();
-  if (all.frames.empty())
-    throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(refused) +
-                             " refused)");
-  // The map first: it is the run's work and what --resume continues. A report file that cannot be
-  // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
-  MapSettings made_with = fingerprintMapSettings(vpack);
-  made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
-  MapStore::save(map_path, filter, encodeOrigins(origins), made_with);
+  return done;
+}
 
-  // The most probable topology decides every place's node.
-  const TopologyEstimate final_estimate = filter.estimate(3);
-  const std::vector<std::int64_t> place_nodes = runner.placeNodes();
-  {
-    // What the run was made with, for the report's header (and a reader of the run folder).
-    const TopologyFilterConfig& topo = filter.config();
-    const auto real = [](double v) {
-      std::ostringstream text;
-      text << v;
-      return text.str();
-    };
-    writeSettings(out_dir,
-                     {{"toposlam", TOPOSLAM_VERSION},
-                      {"preset", preset.name},
-                      {"keypoints", std::string(toString(vpack.keypoints.backend)) + ", at most " +
-                                        std::to_string(vpack.keypoints.max_keypoints) + " per frame"},
-                      {"segmentation.window", segmenter_config.window_s > 0
-                                                  ? real(segmenter_config.window_s) + " s (" +
-                                                        std::to_string(segmenter_config.min_window_frames) + "-" +
-                                                        std::to_string(segmenter_config.window) + " frames)"
-                                                  : std::to_string(segmenter_config.window) + " frames"},
-                      {"segmentation.gamma", real(segmenter_config.valley.gamma)},
-                      {"segmentation.delta", real(segmenter_config.valley.delta)},
-                      {"segmentation.cut", toString(segmenter_config.cut_placement)},
-                      {"segmentation.representative",
-                       segmenter_config.representative == RepresentativeChoice::PlaceMedoid
-                           ? std::string("place-medoid, sampled every ") + real(segmenter_config.representative_interval_s) + " s"
-                           : std::string("window-degree")},
-                      {"topology.particles", std::to_string(topo.particles)},
-                      {"topology.likelihood", toString(topo.likelihood)},
-                      {"topology.seed", std::to_string(topo.seed)},
-                      {"topology.sequence_evidence",
-                       evidence.weight > 0.0 ? "weight " + real(evidence.weight) + ", detections scored at least " +
-                                                   real(evidence.min_score)
-                                             : "off"},
-                      {"frame_loops", by_sequence ? "sequence, decay " + real(sequence_loops.decay) + ", at least " +
-                                                        real(o.loop_min_gap_s) + " s back"
-                                                  : "visits, at least " + std::to_string(o.loop_min_gap) +
-                                                        " frames back"}});
-  }
-  {
-    std::vector<std::string> uris;
-    for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
-    writeSources(out_dir, uris);
-  }
-  // Frame-level loop closures (docs/topology.md): each frame on a node seen on an earlier visit gets that
-  // visit's most similar frame, scored by similarity x the place's node probability at its step.
-  std::vector<FrameRecord> frame_rows = frameRows(all, place_nodes);
-  {
-    std::vector<std::int64_t> place_of_frame;
-    for (const auto& row : all.frames) place_of_frame.push_back(row.place);
-    std::vector<double> place_probability(all.places.size(), 0.0);
-    for (const MappedPlace& step : runner.steps()) {
-      const auto p = static_cast<std::size_t>(step.place.index);
-      if (p < place_probability.size()) place_probability[p] = step.estimate.current_node_probability;
-    }
-    frame_fingerprints.resize(all.frames.size());
-    std::vector<double> time_s;
-    for (const auto& row : all.frames) time_s.push_back(row.time_s);
-    const std::vector<FrameMatch> matches =
-        !by_sequence
-            ? matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
-                                         similarity, o.loop_min_gap)
-            : matchFramesBySequence(time_s, frame_fingerprints, similarity, sequence_loops);
-    for (std::size_t f = 0; f < frame_rows.size(); ++f) {
-      FrameRecord& row = frame_rows[f];
-      if (row.place >= 0 && static_cast<std::size_t>(row.place) < place_probability.size())
-        row.node_probability = place_probability[static_cast<std::size_t>(row.place)];
-      if (f < matches.size()) {
-        row.match = matches[f].match_frame;
-        row.match_score = matches[f].score;
-      }
-    }
-  }
-  frame_fingerprints.clear();
-  writeFrames(out_dir, frame_rows, FrameColumns::WithLoopClosures);
-  writePlaces(out_dir, placeRows(all.places, place_nodes));
-  writeDroppedPlaces(out_dir, placeRows(all.dropped_places));
-  writeTiming(out_dir, timing);
-  writeLambda2Plot(out_dir, all, segmenter_config,
-                   "Fiedler value over " + std::to_string(o.sources.size()) + " source(s)");
-
-  // Nodes and edges of the best topology (over all observations, resumed ones included): the topology
-  // stage's snapshot, the one toposlamd publishes. Observations before this run's first are the resumed
-  // map's (`earlier_places`); this run's are its places.
-  struct NodeInfo {
-    std::vector<std::int64_t> places, representative_frames, earlier_places;
+/// settings.txt: what the run was made with, for the report's header (and a reader of the run folder).
+void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const MethodPreset& preset,
+                      const VpackConfig& vpack, const FiedlerSegmenterConfig& segmenter_config,
+                      const TopologyFilterConfig& topo, const SequenceEvidenceConfig& evidence,
+                      const FrameLoopPlan& loops) {
+  const auto real = [](double v) {
+    std::ostringstream text;
+    text << v;
+    return text.str();
   };
-  std::map<int, NodeInfo> nodes;
-  const TopologySnapshot best = topology->topology();
+  const FiedlerSegmenterConfig& s = segmenter_config;
+  const std::string window =
+      s.window_s > 0
+          ? real(s.window_s) + " s (" + std::to_string(s.min_window_frames) + "-" + std::to_string(s.window) +
+                " frames)"
+          : std::to_string(s.window) + " frames";
+  const std::string representative =
+      s.representative == RepresentativeChoice::PlaceMedoid
+          ? std::string("place-medoid, sampled every ") + real(s.representative_interval_s) + " s"
+          : std::string("window-degree");
+  const std::string sequence_evidence =
+      evidence.weight > 0.0
+          ? "weight " + real(evidence.weight) + ", detections scored at least " + real(evidence.min_score)
+          : "off";
+  const std::string frame_loops =
+      loops.by_sequence
+          ? "sequence, decay " + real(loops.sequence_loops.decay) + ", at least " + real(o.loop_min_gap_s) +
+                " s back"
+          : "visits, at least " + std::to_string(o.loop_min_gap) + " frames back";
+  writeSettings(out_dir, {{"toposlam", TOPOSLAM_VERSION},
+                          {"preset", preset.name},
+                          {"keypoints", std::string(toString(vpack.keypoints.backend)) + ", at most " +
+                                            std::to_string(vpack.keypoints.max_keypoints) + " per frame"},
+                          {"segmentation.window", window},
+                          {"segmentation.gamma", real(s.valley.gamma)},
+                          {"segmentation.delta", real(s.valley.delta)},
+                          {"segmentation.cut", toString(s.cut_placement)},
+                          {"segmentation.representative", representative},
+                          {"topology.particles", std::to_string(topo.particles)},
+                          {"topology.likelihood", toString(topo.likelihood)},
+                          {"topology.seed", std::to_string(topo.seed)},
+                          {"topology.sequence_evidence", sequence_evidence},
+                          {"frame_loops", frame_loops}});
+}
+
+/// frames.csv's rows with their frame-level loop closures (docs/topology.md): each frame on a node seen on
+/// an earlier visit gets that visit's most similar frame, scored by similarity x the place's node
+/// probability at its step. Takes the frames' fingerprints (resized to the run's frames).
+std::vector<FrameRecord> frameRowsWithLoopClosures(
+    const OfflineRunner& runner, const std::vector<std::int64_t>& place_nodes,
+    std::vector<std::shared_ptr<const Fingerprint>>& frame_fingerprints, const NgramSimilarity& similarity,
+    const FrameLoopPlan& loops, int loop_min_gap) {
+  const SegmentationRun& all = runner.run();
+  std::vector<FrameRecord> frame_rows = frameRows(all, place_nodes);
+  std::vector<std::int64_t> place_of_frame;
+  for (const auto& row : all.frames) place_of_frame.push_back(row.place);
+  std::vector<double> place_probability(all.places.size(), 0.0);
+  for (const MappedPlace& step : runner.steps()) {
+    const auto p = static_cast<std::size_t>(step.place.index);
+    if (p < place_probability.size()) place_probability[p] = step.estimate.current_node_probability;
+  }
+  frame_fingerprints.resize(all.frames.size());
+  std::vector<double> time_s;
+  for (const auto& row : all.frames) time_s.push_back(row.time_s);
+  const std::vector<FrameMatch> matches =
+      !loops.by_sequence
+          ? matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
+                                       similarity, loop_min_gap)
+          : matchFramesBySequence(time_s, frame_fingerprints, similarity, loops.sequence_loops);
+  for (std::size_t f = 0; f < frame_rows.size(); ++f) {
+    FrameRecord& row = frame_rows[f];
+    if (row.place >= 0 && static_cast<std::size_t>(row.place) < place_probability.size())
+      row.node_probability = place_probability[static_cast<std::size_t>(row.place)];
+    if (f < matches.size()) {
+      row.match = matches[f].match_frame;
+      row.match_score = matches[f].score;
+    }
+  }
+  return frame_rows;
+}
+
+/// A node of the best topology as the run folder shows it: this run's places (run numbering) with their
+/// representative frames, and the resumed map's observations (`earlier_places`).
+struct NodeInfo {
+  std::vector<std::int64_t> places, representative_frames, earlier_places;
+};
+
+/// The best topology's nodes and edges (over all observations, resumed ones included): the topology stage's
+/// snapshot, the one toposlamd publishes. Observations before `first_observation` are the resumed map's.
+struct RunTopology {
+  std::map<int, NodeInfo> nodes;             ///< by node id; nodes without places left out
+  std::map<std::pair<int, int>, int> edges;  ///< (from, to) -> traversals
+};
+
+RunTopology runTopology(const TopologySnapshot& best, int first_observation) {
+  RunTopology t;
   for (const TopologyNode& node : best.nodes) {
     if (node.places.empty()) continue;
-    NodeInfo& n = nodes[node.id];
+    NodeInfo& n = t.nodes[node.id];
     for (std::size_t i = 0; i < node.places.size(); ++i) {
       if (node.places[i] < first_observation) {
         n.earlier_places.push_back(node.places[i]);
@@ -411,90 +448,107 @@ void runMap(const MapOptions& o, bool filter_options_given) {
       }
     }
   }
-  std::map<std::pair<int, int>, int> edges;
-  for (const TopologyEdge& edge : best.edges) edges[{edge.from, edge.to}] = edge.count;
-  {
-    TopologyFile file;
-    file.probability = final_estimate.best.probability;
-    file.particles = filter.config().particles;
-    TopologyFile::Estimate& e = file.estimate.emplace();
-    e.current_node = final_estimate.current_node;
-    e.current_node_probability = final_estimate.current_node_probability;
-    e.effective_sample_size = final_estimate.effective_sample_size;
-    e.distinct_topologies = final_estimate.distinct_topologies;
-    e.earlier_places = first_observation;
-    for (const TopologyHypothesis& h : final_estimate.alternatives)
-      e.alternatives.push_back(TopologyFile::Alternative{h.probability, h.node_count, h.first_difference});
-    for (const auto& [node, info] : nodes) {
-      TopologyFile::Node& n = file.nodes.emplace_back();
-      n.id = node;
-      for (std::int64_t p : info.places) n.places.push_back(static_cast<int>(p));
-      n.representative_frames = info.representative_frames;
-      for (std::int64_t p : info.earlier_places) n.earlier_places.push_back(static_cast<int>(p));
-    }
-    for (const auto& [edge, count] : edges) file.edges.push_back(TopologyFile::Edge{edge.first, edge.second, count});
-    for (const MappedPlace& s : runner.steps()) {
-      TopologyFile::Step& step = file.history.emplace_back();
-      step.place = static_cast<int>(s.place.index);
-      step.node = s.estimate.current_node;
-      step.probability = s.estimate.current_node_probability;
-      step.best_topology_probability = s.estimate.best.probability;
-      step.effective_sample_size = s.estimate.effective_sample_size;
-    }
-    writeTopology(out_dir, file);
-  }
-  {
-    std::ostringstream dot;
-    dot << "digraph topology {\n  graph [label=\"most probable topology, p = " << std::setprecision(3)
-        << final_estimate.best.probability << "\", labelloc=t];\n  node [shape=circle, style=filled, "
-        << "fillcolor=\"#dde8f5\", fontname=\"Helvetica\"];\n  edge [fontname=\"Helvetica\", fontsize=10];\n";
-    for (const auto& [node, info] : nodes) {
-      dot << "  n" << node << " [label=\"" << node << "\\nplaces";
-      for (std::size_t i = 0; i < info.places.size(); ++i) dot << (i == 0 ? " " : ",") << info.places[i];
-      if (!info.earlier_places.empty()) dot << "\\n(+" << info.earlier_places.size() << " earlier)";
-      dot << "\"" << (node == final_estimate.current_node ? ", fillcolor=\"#f5c542\"" : "") << "];\n";
-    }
-    for (const auto& [edge, count] : edges) {
-      dot << "  n" << edge.first << " -> n" << edge.second << " [label=\"" << count << "\"];\n";
-    }
-    dot << "}\n";
-    {
-      OutputFile out = openOutput(out_dir / "topology.dot");
-      out << dot.str();
-      out.commit();
-    }
-    if (programOnPath("dot")) {
-      const std::string dot_file = (out_dir / "topology.dot").string();
-      for (const char* format : {"svg", "png"}) {
-        // Drawn to a temporary name and renamed only when dot succeeded: a failing dot (a full disk) leaves
-        // the earlier drawing, never a truncated one, under the real name.
-        const fs::path final_path = out_dir / (std::string("topology.") + format);
-        const fs::path temporary = out_dir / (std::string(".topology.") + format + ".tmp");
-        const std::vector<std::string> command = {"dot", std::string("-T") + format, dot_file, "-o",
-                                                  temporary.string()};
-        std::error_code error;
-        if (runProgram(command) != 0) {
-          std::cerr << "map: warning: `dot -T" << format << " " << shellQuote(dot_file) << " -o "
-                    << shellQuote(temporary.string()) << "` failed; " << final_path.string() << " not written\n";
-          fs::remove(temporary, error);
-        } else if (fs::rename(temporary, final_path, error); error) {
-          std::cerr << "map: warning: cannot rename " << temporary.string() << " to " << final_path.string() << ": "
-                    << error.message() << "\n";
-          fs::remove(temporary, error);
-        }
-      }
-    } else {
-      std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
-    }
-  }
+  for (const TopologyEdge& edge : best.edges) t.edges[{edge.from, edge.to}] = edge.count;
+  return t;
+}
 
+/// topology.json: the best topology, the final estimate and the history of the filter steps.
+void writeTopologyJson(const fs::path& out_dir, const RunTopology& topology,
+                       const TopologyEstimate& final_estimate, int particles, int first_observation,
+                       const std::vector<MappedPlace>& steps) {
+  TopologyFile file;
+  file.probability = final_estimate.best.probability;
+  file.particles = particles;
+  TopologyFile::Estimate& e = file.estimate.emplace();
+  e.current_node = final_estimate.current_node;
+  e.current_node_probability = final_estimate.current_node_probability;
+  e.effective_sample_size = final_estimate.effective_sample_size;
+  e.distinct_topologies = final_estimate.distinct_topologies;
+  e.earlier_places = first_observation;
+  for (const TopologyHypothesis& h : final_estimate.alternatives)
+    e.alternatives.push_back(TopologyFile::Alternative{h.probability, h.node_count, h.first_difference});
+  for (const auto& [node, info] : topology.nodes) {
+    TopologyFile::Node& n = file.nodes.emplace_back();
+    n.id = node;
+    for (std::int64_t p : info.places) n.places.push_back(static_cast<int>(p));
+    n.representative_frames = info.representative_frames;
+    for (std::int64_t p : info.earlier_places) n.earlier_places.push_back(static_cast<int>(p));
+  }
+  for (const auto& [edge, count] : topology.edges)
+    file.edges.push_back(TopologyFile::Edge{edge.first, edge.second, count});
+  for (const MappedPlace& s : steps) {
+    TopologyFile::Step& step = file.history.emplace_back();
+    step.place = static_cast<int>(s.place.index);
+    step.node = s.estimate.current_node;
+    step.probability = s.estimate.current_node_probability;
+    step.best_topology_probability = s.estimate.best.probability;
+    step.effective_sample_size = s.estimate.effective_sample_size;
+  }
+  writeTopology(out_dir, file);
+}
+
+/// The best topology in Graphviz' language, the current node highlighted.
+std::string topologyDot(const RunTopology& topology, const TopologyEstimate& final_estimate) {
+  std::ostringstream dot;
+  dot << "digraph topology {\n  graph [label=\"most probable topology, p = " << std::setprecision(3)
+      << final_estimate.best.probability << "\", labelloc=t];\n  node [shape=circle, style=filled, "
+      << "fillcolor=\"#dde8f5\", fontname=\"Helvetica\"];\n  edge [fontname=\"Helvetica\", fontsize=10];\n";
+  for (const auto& [node, info] : topology.nodes) {
+    dot << "  n" << node << " [label=\"" << node << "\\nplaces";
+    for (std::size_t i = 0; i < info.places.size(); ++i) dot << (i == 0 ? " " : ",") << info.places[i];
+    if (!info.earlier_places.empty()) dot << "\\n(+" << info.earlier_places.size() << " earlier)";
+    dot << "\"" << (node == final_estimate.current_node ? ", fillcolor=\"#f5c542\"" : "") << "];\n";
+  }
+  for (const auto& [edge, count] : topology.edges) {
+    dot << "  n" << edge.first << " -> n" << edge.second << " [label=\"" << count << "\"];\n";
+  }
+  dot << "}\n";
+  return dot.str();
+}
+
+/// topology.dot, and topology.svg and .png drawn from it when Graphviz' `dot` is installed (a warning,
+/// not an error, when it fails).
+void writeTopologyDrawings(const fs::path& out_dir, const std::string& dot) {
+  {
+    OutputFile out = openOutput(out_dir / "topology.dot");
+    out << dot;
+    out.commit();
+  }
+  if (!programOnPath("dot")) {
+    std::cerr << "map: Graphviz `dot` not found: wrote topology.dot only\n";
+    return;
+  }
+  const std::string dot_file = (out_dir / "topology.dot").string();
+  for (const char* format : {"svg", "png"}) {
+    // Drawn to a temporary name and renamed only when dot succeeded: a failing dot (a full disk) leaves
+    // the earlier drawing, never a truncated one, under the real name.
+    const fs::path final_path = out_dir / (std::string("topology.") + format);
+    const fs::path temporary = out_dir / (std::string(".topology.") + format + ".tmp");
+    const std::vector<std::string> command = {"dot", std::string("-T") + format, dot_file, "-o",
+                                              temporary.string()};
+    std::error_code error;
+    if (runProgram(command) != 0) {
+      std::cerr << "map: warning: `dot -T" << format << " " << shellQuote(dot_file) << " -o "
+                << shellQuote(temporary.string()) << "` failed; " << final_path.string() << " not written\n";
+      fs::remove(temporary, error);
+    } else if (fs::rename(temporary, final_path, error); error) {
+      std::cerr << "map: warning: cannot rename " << temporary.string() << " to " << final_path.string()
+                << ": " << error.message() << "\n";
+      fs::remove(temporary, error);
+    }
+  }
+}
+
+/// The run in one line on stdout, or one JSON object with --json.
+void printSummary(const MapOptions& o, const SegmentationRun& all, std::size_t nodes,
+                  const TopologyEstimate& final_estimate, const fs::path& out_dir) {
   if (o.json) {
     JsonWriter json(std::cout);
     json.beginObject()
         .field("frames", all.frames.size())
         .field("places", all.places.size())
         .field("dropped_places", all.dropped_places.size())
-        .field("nodes", nodes.size())
+        .field("nodes", nodes)
         .field("best_topology_probability", final_estimate.best.probability)
         .field("current_node", final_estimate.current_node)
         .field("current_node_probability", final_estimate.current_node_probability)
@@ -506,9 +560,76 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   std::printf(
       "%zu frames -> %zu places mapped (%zu dropped) -> %zu nodes; best topology p = %.3f, current node %d "
       "p = %.3f; wrote %s\n",
-      all.frames.size(), all.places.size(), all.dropped_places.size(), nodes.size(),
-      final_estimate.best.probability, final_estimate.current_node, final_estimate.current_node_probability,
-      out_dir.string().c_str());
+      all.frames.size(), all.places.size(), all.dropped_places.size(), nodes, final_estimate.best.probability,
+      final_estimate.current_node, final_estimate.current_node_probability, out_dir.string().c_str());
+}
+
+/// `toposlam map`: set up the stages, run every source through them, save the map, write the run folder.
+void runMap(const MapOptions& o, bool filter_options_given) {
+  if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
+  FiedlerSegmenterConfig segmenter_config = segmenterConfig(o.segmentation, "map");  // --window-m: openMotion
+  std::optional<MotionReplay> motion = openMotion(o.motion, o.sources.size(), "map", segmenter_config);
+  const fs::path out_dir(o.out);
+  createRunFolder(o.out);
+  const fs::path map_path = out_dir / "map.tsm";
+  const MapLock map_lock = lockRunFolderMap(map_path, o.out);
+
+  const MethodPreset preset = presetOf(o.segmentation, "map");
+  const VpackConfig vpack = fingerprintConfig(o, preset);
+  VpackFingerprintStage fingerprint_stage(vpack, nullptr);  // no thumbnails: no place events offline
+  const FrameLoopPlan loops = frameLoopPlan(o, preset);
+  const NgramSimilarity similarity(similarityConfig(o, preset));
+
+  // The filter steps run to their end before the next frame, so the budget's clock is never read for a
+  // decision (ParticleFilterTopologyStage::advance with an infinite budget).
+  const ManualClock clock;
+  StartingFilter start = o.resume.empty() ? newFilter(o, preset, similarity, clock)
+                                          : resumedFilter(o, vpack, similarity, clock, filter_options_given);
+  ParticleFilterTopologyStage& topology = *start.topology;
+  const TopologyParticleFilter& filter = topology.filter();
+  const int first_observation = filter.observationCount();
+
+  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, loops.sequence_loops);
+  // Thumbnails are the daemon's (place events); the offline run keeps none.
+  FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
+  OfflineRunner runner(fingerprint_stage, segmentation_stage, &topology);
+  Traversals traversals =
+      traverseSources(o, runner, segmentation_stage, motion, start.origins, start.run_number);
+  if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
+  const SegmentationRun& all = runner.run();
+  if (all.frames.empty())
+    throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(traversals.refused) +
+                             " refused)");
+  // The map first: it is the run's work and what --resume continues. A report file that cannot be
+  // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
+  MapSettings made_with = fingerprintMapSettings(vpack);
+  made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
+  MapStore::save(map_path, filter, encodeOrigins(start.origins), made_with);
+
+  // The most probable topology decides every place's node.
+  const TopologyEstimate final_estimate = filter.estimate(3);
+  const std::vector<std::int64_t> place_nodes = runner.placeNodes();
+  writeRunSettings(out_dir, o, preset, vpack, segmenter_config, filter.config(), evidence, loops);
+  {
+    std::vector<std::string> uris;
+    for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
+    writeSources(out_dir, uris);
+  }
+  const std::vector<FrameRecord> frame_rows = frameRowsWithLoopClosures(
+      runner, place_nodes, traversals.frame_fingerprints, similarity, loops, o.loop_min_gap);
+  traversals.frame_fingerprints.clear();
+  writeFrames(out_dir, frame_rows, FrameColumns::WithLoopClosures);
+  writePlaces(out_dir, placeRows(all.places, place_nodes));
+  writeDroppedPlaces(out_dir, placeRows(all.dropped_places));
+  writeTiming(out_dir, traversals.timing);
+  writeLambda2Plot(out_dir, all, segmenter_config,
+                   "Fiedler value over " + std::to_string(o.sources.size()) + " source(s)");
+
+  const RunTopology best = runTopology(topology.topology(), first_observation);
+  writeTopologyJson(out_dir, best, final_estimate, filter.config().particles, first_observation,
+                    runner.steps());
+  writeTopologyDrawings(out_dir, topologyDot(best, final_estimate));
+  printSummary(o, all, best.nodes.size(), final_estimate, out_dir);
 }
 
 }  // namespace

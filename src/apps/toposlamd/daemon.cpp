@@ -76,7 +76,8 @@ struct Assembly {
   Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri) {
     source = openSource(source_uri);
     pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers, namedWorkers("tsl-vpack"));
-    fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get());
+    fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get(),
+                                                          config.fingerprint_stage.thumbnail_width);
     similarity = std::make_unique<NgramSimilarity>(config.similarity);
     segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity, 600,
                                                                config.segmentation_stage.motion, config.sequence_evidence);
