@@ -29,13 +29,19 @@ TEST_CASE(
   filter->saveState(out);
   const std::string state = out.str();
   REQUIRE(state.size() > 100);
-  // The state ends with the likelihood block (u8 + 3 f64); a state cut just before it is a state written
-  // before the block existed, and loads with the thesis' absolute likelihood. Every other cut throws.
+  // The state ends with the likelihood block (u8 + 3 f64) and the new-node block (u8). A state cut just
+  // before either is one written before that block existed: before the likelihood block it loads with the
+  // thesis' absolute likelihood, before the new-node block with eq. 5.7's entropy. Every other cut throws.
+  constexpr std::size_t kNewNodeBlock = 1;
   constexpr std::size_t kLikelihoodBlock = 1 + 3 * 8;
   for (std::size_t cut = 0; cut < state.size(); ++cut) {
     std::istringstream in(state.substr(0, cut));
-    if (cut == state.size() - kLikelihoodBlock) {
+    if (cut == state.size() - kNewNodeBlock - kLikelihoodBlock) {
       CHECK(TopologyParticleFilter::loadState(in, sim)->config().likelihood == LikelihoodModel::Absolute);
+      continue;
+    }
+    if (cut == state.size() - kNewNodeBlock) {
+      CHECK(TopologyParticleFilter::loadState(in, sim)->config().new_node_entropy);
       continue;
     }
     CHECK_THROWS_AS(TopologyParticleFilter::loadState(in, sim), std::runtime_error);
@@ -74,6 +80,31 @@ TEST_CASE(
   // A change in either count means the loader's validation changed: look at which flips moved.
   CHECK(loaded == 59);
   CHECK(refused == 294);
+}
+
+TEST_CASE("GIVEN a filter without eq. 5.7's entropy WHEN saved and loaded THEN the loaded one keeps 1 - max L",
+          "[topology][map]") {
+  auto sim = placeSimilarity();
+  for (const bool entropy : {false, true}) {
+    TopologyFilterConfig config;
+    config.particles = 50;
+    config.likelihood = LikelihoodModel::Relative;
+    config.new_node_entropy = entropy;
+    TopologyParticleFilter filter(config, sim);
+    for (int k = 0; k < 6; ++k) filter.step(taggedFingerprint(k % 3));
+    std::ostringstream out;
+    filter.saveState(out);
+    std::istringstream in(out.str());
+    auto loaded = TopologyParticleFilter::loadState(in, sim);
+    CHECK(loaded->config().new_node_entropy == entropy);
+    // The loaded filter steps as the original does.
+    filter.step(taggedFingerprint(1));
+    loaded->step(taggedFingerprint(1));
+    std::ostringstream a, b;
+    filter.saveState(a);
+    loaded->saveState(b);
+    CHECK(a.str() == b.str());
+  }
 }
 
 TEST_CASE("GIVEN a filter frozen between steps WHEN it goes on stepping while another thread encodes the "

@@ -353,6 +353,45 @@ TEST_CASE(
   }
 }
 
+TEST_CASE(
+    "GIVEN one weak standout among relative likelihoods WHEN a new node's likelihood takes eq. 5.7's entropy THEN "
+    "the weak match wins the particles, and with 1 - max L a new node does",
+    "[topology][relative]") {
+  // The look-alike rooms' step 6 (docs/topology.md, "The new node's likelihood"): the new place scores 0.42
+  // with place 0 and 0.00-0.15 with the other five, a leave-one-out z of about 6.
+  const std::array<double, 6> to_last{0.4216, 0.1527, 0.0, 0.0576, 0.0899, 0.004};
+  const test::TagSimilarity sim([&](int a, int b) {
+    if (a == b) return 1.0;
+    if (std::max(a, b) == 6) return to_last[static_cast<std::size_t>(std::min(a, b))];
+    return 0.01 + 0.01 * ((a * 7 + b * 3) % 5);
+  });
+  const auto lastStep = [&](bool entropy, double offset) {
+    TopologyFilterConfig config = configWith(500, 1);
+    config.likelihood = LikelihoodModel::Relative;
+    config.relative_slope = 2.0;
+    config.relative_offset = offset;
+    config.new_node_entropy = entropy;
+    TopologyParticleFilter filter(config, sim);
+    run(filter, {0, 1, 2, 3, 4, 5, 6});
+    const TopologyEstimate e = filter.estimate(0);
+    REQUIRE(e.best.assignment.size() == 7);
+    return std::pair<int, double>(e.best.assignment.back(), e.best.probability);
+  };
+  // Offset 8: the match's likelihood is about 0.035, yet with the entropy it takes nearly every particle.
+  const auto [with_entropy, p_with] = lastStep(true, 8.0);
+  CHECK(with_entropy == 0);
+  CHECK(p_with > 0.9);
+  const auto [without, p_without] = lastStep(false, 8.0);
+  CHECK(without == 6);
+  CHECK(p_without > 0.9);
+  // The default preset's offset 4.25: the match's likelihood is about 0.98 and the closure is proposed, but
+  // the new-node hypothesis keeps a share (the look-alike rooms undo it with the next place).
+  const auto [preset, p_preset] = lastStep(false, 4.25);
+  CHECK(preset == 0);
+  CHECK(p_preset > 0.5);
+  CHECK(p_preset < 0.95);
+}
+
 TEST_CASE("GIVEN evidence from outside the representatives WHEN a step takes it THEN a revisit the appearance cannot "
           "tell wins, and bad evidence is refused",
           "[topology][evidence]") {
