@@ -25,7 +25,8 @@ DESTDIR="$tmp/install" cmake --install "$build" --prefix /usr >/dev/null
 (cd "$tmp/install" && find . ! -type d | sed 's|^\./|/|' | sort) >"$tmp/installed"
 diff "$tmp/installed" "$tmp/files" >"$tmp/files.diff" \
   || { cat "$tmp/files.diff"; fail "the package's files differ from cmake --install --prefix /usr (< install, > package)"; }
-for f in /usr/bin/toposlam /usr/sbin/toposlamd /usr/bin/toposlam-bridge /usr/lib/systemd/system/toposlamd.service \
+for f in /usr/bin/toposlam /usr/sbin/toposlamd /usr/bin/toposlam-bridge /usr/bin/toposlam-bench \
+         /usr/share/man/man1/toposlam-bench.1.gz /usr/lib/systemd/system/toposlamd.service \
          /etc/toposlam/toposlam.yaml /etc/toposlam/toposlam-bridge.yaml /usr/share/toposlam/lcm/place_t.lcm \
          /usr/include/toposlam_lcm/place_t.hpp /usr/share/pkgconfig/toposlam-lcm.pc /usr/share/doc/toposlam/copyright \
          /usr/share/doc/toposlam/changelog.gz /usr/share/man/man1/toposlam.1.gz /usr/share/man/man8/toposlamd.8.gz \
@@ -63,6 +64,8 @@ echo "$out" | grep -q "config OK" || fail "toposlamd --check-config said: $out"
 [ "$("$tmp/root/usr/bin/toposlam" --version)" = "toposlam $version" ] || fail "toposlam --version: $("$tmp/root/usr/bin/toposlam" --version)"
 [ "$("$tmp/root/usr/sbin/toposlamd" --version)" = "toposlamd $version" ] || fail "toposlamd --version"
 [ "$("$tmp/root/usr/bin/toposlam-bridge" --version)" = "toposlam-bridge $version" ] || fail "toposlam-bridge --version"
+[ "$("$tmp/root/usr/bin/toposlam-bench" --version)" = "toposlam-bench $version" ] \
+  || fail "toposlam-bench --version"
 grep -qx "ExecStart=/usr/sbin/toposlamd" "$tmp/root/usr/lib/systemd/system/toposlamd.service" \
   || fail "the packaged unit does not start /usr/sbin/toposlamd"
 # The message headers compile with the flags of the packaged pkg-config file.

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "bench_stats.hpp"
 #include "commands.hpp"
 #include "motion_input.hpp"
 #include "offline_run_io.hpp"
+#include "timing.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/io/source_uri.hpp"

@@ -2,7 +2,7 @@
 // frames (frames/000000.png ...), the ground truth (labels.csv: frame,time,room,x,y,heading,traversal), the
 // loop-closure matrix of the labels (loop_closure.png, laid out like samples_GT.bmp) and a top-down map
 // of the world with the route (map.png), and the robot's own motion as wheel odometry would give it
-// (motion.csv: time_s,distance_m,speed_mps,turn_rate_rps per frame; `map --motion`). Rendering speed: `toposlam bench sim`.
+// (motion.csv: time_s,distance_m,speed_mps,turn_rate_rps per frame; `map --motion`). Rendering speed: `toposlam-bench sim`.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>

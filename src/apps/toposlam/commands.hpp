@@ -7,7 +7,8 @@
 namespace toposlam::cli {
 
 void addFingerprintCommand(CLI::App& app);
-void addBenchCommand(CLI::App& app);
+/// `toposlam bench ...`, hidden: one line saying the benchmarks moved to toposlam-bench, exit 2.
+void addBenchMovedCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addSegmentCommand(CLI::App& app);
 void addCaptureCommand(CLI::App& app);
@@ -19,14 +20,5 @@ void addConfigCommand(CLI::App& app);
 void addSimilarityCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);
 void addRecognitionCommand(CLI::App& app);
-
-// Sub-benchmarks of `toposlam bench`, each in its module's bench_<module>.cpp (called from command_bench.cpp).
-void addBenchFingerprint(CLI::App& bench);
-void addBenchTopology(CLI::App& bench);
-void addBenchSegmentation(CLI::App& bench);
-void addBenchSim(CLI::App& bench);
-void addBenchMatching(CLI::App& bench);
-void addBenchPipeline(CLI::App& bench);
-void addBenchMapSize(CLI::App& bench);
 
 }  // namespace toposlam::cli

@@ -1,4 +1,5 @@
-// Small helpers shared by the `toposlam bench ...` commands: timing samples and their summary.
+// Small helpers shared by the `toposlam-bench ...` commands: the measured rows, in text or JSON; the timing
+// samples and their summary are timing.hpp's (src/apps/common, toposlam's `segment` times itself too).
 // Benchmarks print numbers; they never fail a build.
 #pragma once
 
@@ -13,41 +14,12 @@
 #include <variant>
 #include <vector>
 
+#include "timing.hpp"
 #include "toposlam/core/json_writer.hpp"
 
 namespace toposlam::cli {
 
-struct TimingSummary {
-  double median_ms = 0, p99_ms = 0, max_ms = 0, mean_ms = 0;
-  std::size_t samples = 0;
-};
-
-inline TimingSummary summarize(std::vector<double> ms) {
-  TimingSummary s;
-  if (ms.empty()) return s;
-  std::sort(ms.begin(), ms.end());
-  s.samples = ms.size();
-  s.median_ms = ms[ms.size() / 2];
-  s.p99_ms = ms[std::min(ms.size() - 1, static_cast<std::size_t>(std::ceil(0.99 * ms.size())) - 1)];
-  s.max_ms = ms.back();
-  double total = 0;
-  for (double v : ms) total += v;
-  s.mean_ms = total / ms.size();
-  return s;
-}
-
-class Stopwatch {
- public:
-  Stopwatch() : start_(std::chrono::steady_clock::now()) {}
-  double elapsedMs() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
-  }
-
- private:
-  std::chrono::steady_clock::time_point start_;
-};
-
-/// The measured rows of a `toposlam bench ...` command. Without --json the command prints its table to stdout
+/// The measured rows of a `toposlam-bench ...` command. Without --json the command prints its table to stdout
 /// as before and the rows are not kept; with --json the table goes to stderr (for the person watching) and the
 /// rows are printed at the end as one JSON object on stdout: {"benchmark": "topology", "rows": [{...}, ...]}.
 class BenchRows {

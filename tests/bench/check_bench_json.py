@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""Smoke test of `toposlam bench pipeline --json` and `toposlam bench map-size --json`, run tiny: the JSON
+"""Smoke test of `toposlam-bench pipeline --json` and `toposlam-bench map-size --json`, run tiny: the JSON
 has every field with sane values (fps > 0, p99 >= median, max >= p99, peak RSS > 0). No speed threshold:
 benchmarks print numbers, they fail no build.
 
-usage: check_bench_json.py TOPOSLAM pipeline|map-size"""
+usage: check_bench_json.py TOPOSLAM_BENCH pipeline|map-size"""
 import json
 import subprocess
 import sys
@@ -23,9 +23,9 @@ def check_stats(where, stats, samples_at_least):
     assert 0 <= stats["median_ms"] <= stats["p99_ms"] <= stats["max_ms"], f"{where}: {stats}"
 
 
-def check_pipeline(toposlam):
+def check_pipeline(toposlam_bench):
     frames = 40
-    out = run([toposlam, "bench", "pipeline", "--json", "--sizes", "160x120", "--cores", "1", "2", "--frames",
+    out = run([toposlam_bench, "pipeline", "--json", "--sizes", "160x120", "--cores", "1", "2", "--frames",
                str(frames), "--distinct-frames", "20", "--rate", "400"])
     runs = out["runs"]
     modes = {(r["cores"], r["mode"]) for r in runs}
@@ -48,8 +48,8 @@ def check_pipeline(toposlam):
     print("pipeline JSON OK:", len(runs), "runs")
 
 
-def check_map_size(toposlam):
-    out = run([toposlam, "bench", "map-size", "--json", "--places", "120", "--particles", "50", "--checkpoint",
+def check_map_size(toposlam_bench):
+    out = run([toposlam_bench, "map-size", "--json", "--places", "120", "--particles", "50", "--checkpoint",
                "60", "--exhaustive-up-to", "40", "--candidates", "20", "--background-samples", "20",
                "--compare-every", "10", "--control"])
     assert out["steps"] == 120

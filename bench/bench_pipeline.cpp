@@ -1,4 +1,4 @@
-// `toposlam bench pipeline`: the whole real-time pipeline as toposlamd runs it (capture, fingerprint,
+// `toposlam-bench pipeline`: the whole real-time pipeline as toposlamd runs it (capture, fingerprint,
 // segmentation, topology filter, LCM publish; the same stage adapters, threads and queues), at each frame
 // size, on one CPU and on two. Frames are rendered by the source (default: the simulated office) BEFORE
 // the runs and kept in memory, then played in a loop, so the renderer's cost does not count against the
@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/worker_pool.hpp"

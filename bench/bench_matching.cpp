@@ -1,4 +1,4 @@
-// `toposlam bench similarity`: n-gram similarities per second on one core (issue target: >= 20,000/s for
+// `toposlam-bench similarity`: n-gram similarities per second on one core (issue target: >= 20,000/s for
 // 640x480 ORB fingerprints). Fingerprints the sample frames once (upscaled to --size), then times every
 // NgramSimilarity call of --repeat passes over all ordered pairs of --frames frames. Prints the median and
 // p99 time per similarity and the rate per pass; asserts nothing.
@@ -10,7 +10,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench_stats.hpp"
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "image_input.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"

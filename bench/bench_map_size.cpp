@@ -1,4 +1,4 @@
-// `toposlam bench map-size`: what a new place costs as the map grows to 10,000 places (issue 18: under
+// `toposlam-bench map-size`: what a new place costs as the map grows to 10,000 places (issue 18: under
 // 20 ms and 200 MB resident with 500 particles), with the candidate index (docs/topology.md, "Large
 // maps"), and how often its decision equals the exhaustive comparison's.
 //
@@ -34,7 +34,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench_stats.hpp"
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "image_input.hpp"
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/json_writer.hpp"

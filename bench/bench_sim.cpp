@@ -1,4 +1,4 @@
-// `toposlam bench sim`: frames per second of the simulated world's renderer on ONE core (OpenCV limited
+// `toposlam-bench sim`: frames per second of the simulated world's renderer on ONE core (OpenCV limited
 // to one thread, no worker pool: the renderer is single-threaded), with per-frame median and p99 over a
 // whole route, and the target (>= 200 frames/s at 320x240) checked in the output. Prints numbers,
 // fails nothing.
@@ -11,7 +11,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench_stats.hpp"
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "toposlam/sim/simulator.hpp"
 
 namespace toposlam::cli {

@@ -1,8 +1,10 @@
-// `toposlam bench startup`: how long a command takes from exec to exit and how much memory it touches,
+// `toposlam-bench startup`: how long a command takes from exec to exit and how much memory it touches,
 // whole process (loading the shared libraries included): `toposlam --version`, `toposlam --help`, and
 // `toposlam map` over the bundled frames (ms per frame). Each run is a child process started with
 // posix_spawn; its time is the wall time to its exit, its memory the peak resident set (ru_maxrss) the
 // kernel reports for it. Medians of --runs runs. Prints numbers, asserts nothing (docs/performance.md).
+// The program measured is toposlam, not this one (the benchmarks were inside it until issue 15): --toposlam
+// PATH, else the toposlam beside this program (both installed in /usr/bin), else the build tree's.
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/resource.h>
@@ -18,7 +20,7 @@
 #include <memory>
 
 #include "bench_stats.hpp"
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "image_input.hpp"
 #include "toposlam/io/file_sources.hpp"
 
@@ -29,6 +31,7 @@ namespace toposlam::cli {
 namespace {
 
 struct StartupBenchOptions {
+  std::string toposlam;
   int runs = 9;
   std::string samples;
   bool json = false;
@@ -39,9 +42,18 @@ struct ChildRun {
   double peak_mb = 0;
 };
 
-/// Runs this program with `args` (stdout and stderr to /dev/null); throws when it cannot be started or fails.
-ChildRun runSelf(const std::vector<std::string>& args) {
-  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+/// The toposlam to measure when no --toposlam is given: the one beside this program, else the build tree's.
+std::string defaultToposlam() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path beside = self.parent_path() / "toposlam";
+  if (!error && ::access(beside.c_str(), X_OK) == 0) return beside.string();
+  return TOPOSLAM_BUILD_TREE_TOPOSLAM;
+}
+
+/// Runs `self` (toposlam) with `args` (stdout and stderr to /dev/null); throws when it cannot be started or
+/// fails.
+ChildRun runToposlam(const std::string& self, const std::vector<std::string>& args) {
   std::vector<char*> argv{const_cast<char*>(self.c_str())};
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -86,7 +98,7 @@ void runStartupBench(const StartupBenchOptions& o) {
     std::vector<double> ms;
     double peak_mb = 0;
     for (int r = 0; r < o.runs; ++r) {
-      const ChildRun run = runSelf(c.args);
+      const ChildRun run = runToposlam(o.toposlam, c.args);
       ms.push_back(run.ms);
       peak_mb = std::max(peak_mb, run.peak_mb);
     }
@@ -110,12 +122,19 @@ void addBenchStartup(CLI::App& bench) {
   options->samples = defaultSamplesFolder();
   auto* cmd = bench.add_subcommand(
       "startup", "Whole-process ms and peak MB of `toposlam --version`, `--help` and `map` over the sample frames");
+  cmd->add_option("--toposlam", options->toposlam,
+                  "The toposlam program to measure (default: the one beside this program, else the build "
+                  "tree's)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--runs", options->runs, "Runs of each command (the median is printed)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--samples", options->samples, "Folder of frames for `map`")->capture_default_str();
   cmd->add_flag("--json", options->json, "Print the rows as one JSON object (the table goes to stderr)");
-  cmd->callback([options] { runStartupBench(*options); });
+  cmd->callback([options] {
+    if (options->toposlam.empty()) options->toposlam = defaultToposlam();
+    runStartupBench(*options);
+  });
 }
 
 }  // namespace toposlam::cli

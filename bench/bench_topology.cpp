@@ -1,4 +1,4 @@
-// `toposlam bench topology`: ms per TopologyParticleFilter step (500 particles) at 10, 100 and 1000
+// `toposlam-bench topology`: ms per TopologyParticleFilter step (500 particles) at 10, 100 and 1000
 // places with synthetic fingerprints and a cheap fake similarity, the longest slice of a step run with
 // advance(budget), and, separately, what the once-per-step similarity against N real stored
 // representatives costs with NgramSimilarity (VPACK of the bundled sample frames). Prints, fails nothing.
@@ -12,7 +12,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench_stats.hpp"
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "config_key_options.hpp"
 #include "image_input.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"

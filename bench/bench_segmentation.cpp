@@ -1,4 +1,4 @@
-// `toposlam bench segmentation`: ms per frame of the segmentation step (FiedlerSegmenter::addFrame:
+// `toposlam-bench segmentation`: ms per frame of the segmentation step (FiedlerSegmenter::addFrame:
 // the new frame's 2 (n-1) n-gram similarities, L_sym, lambda2, valley detection, representatives) on
 // ORB fingerprints of the sample frames upscaled to 640x480. Reported twice: with the real similarity,
 // and with the similarities looked up from a precomputed table (the linear algebra alone; the thesis
@@ -12,7 +12,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench_stats.hpp"
-#include "commands.hpp"
+#include "benchmarks.hpp"
 #include "image_input.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
