@@ -3,7 +3,7 @@
 # Run on demand (not by CI, not by scripts/test.sh). docs/arm64.md says what it does and what was measured.
 #   scripts/cross-arm64.sh              install what is missing, build into build-arm64/, run the tests
 #   scripts/cross-arm64.sh --no-tests   build only
-#   scripts/cross-arm64.sh --bench      also `toposlam bench fingerprint` under qemu (emulated timings)
+#   scripts/cross-arm64.sh --bench      also `toposlam-bench fingerprint` under qemu (emulated timings)
 #   scripts/cross-arm64.sh --no-install fail with a message instead of installing anything
 # Environment: ARM64_BUILD_DIR (default build-arm64), TOPOSLAM_ARM64_SYSROOT (default ARM64_BUILD_DIR/sysroot),
 # CTEST_ARGS (more ctest options), BUILD_TYPE (default Release).
@@ -210,8 +210,8 @@ fi
 # --- 5. Emulated timings: wall-clock ms per frame under qemu-user, a relative figure, not arm64 hardware's.
 if [ "$run_bench" = 1 ]; then
   qemu="$(command -v qemu-aarch64 || command -v qemu-aarch64-static)"
-  say "toposlam bench fingerprint under $qemu (EMULATED: timings are qemu's, not an arm64 CPU's)"
-  low "$qemu" -L "$sysroot" "$build/src/apps/toposlam/toposlam" bench fingerprint --keypoints orb --workers 1 ||
+  say "toposlam-bench fingerprint under $qemu (EMULATED: timings are qemu's, not an arm64 CPU's)"
+  low "$qemu" -L "$sysroot" "$build/bench/toposlam-bench" fingerprint --keypoints orb --workers 1 ||
     die "the emulated bench failed"
 fi
 
