@@ -8,8 +8,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bench_stats.hpp"
-#include "camera_pixels.hpp"
 #include "benchmarks.hpp"
+#include "camera_pixels.hpp"
 #include "image_input.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
