@@ -617,7 +617,9 @@ const std::vector<ConfigSection>& daemonConfigSections() {
       {"pipeline.queues", "queue capacities between the stage threads"},
       {"pipeline.threads", "per thread: name, CPU pinning, scheduling policy, priority, nice"},
       {"pipeline.threads.capture", "reads frames from the source"},
-      {"pipeline.threads.fingerprint", "fingerprints frames (with fingerprint.workers - 1 pool threads)"},
+      {"pipeline.threads.fingerprint",
+       "fingerprints frames (with fingerprint.workers - 1 pool threads tsl-vpack-N, which take its policy, "
+       "priority and nice, not its CPU)"},
       {"pipeline.threads.segmentation", "segments the stream into places"},
       {"pipeline.threads.topology", "runs the particle filter over topologies"},
       {"pipeline.threads.publisher", "publishes over LCM"},

@@ -1,14 +1,19 @@
 #!/bin/sh
 # The daemon's I/O threads come from the one thread table (pipeline.threads.lcm_receiver / .recorder):
-# names and nice values set in the config file are the ones the running toposlamd's threads carry.
+# names and nice values set in the config file are the ones the running toposlamd's threads carry. The
+# fingerprint stage's pool threads (tsl-vpack-N) take the fingerprint thread's nice.
 # Exits 77 (skipped) without /proc. Usage: check_io_thread_settings.sh TOPOSLAMD SAMPLES_DIR WORK_DIR
 set -eu
 toposlamd=$1 samples=$2 work=$3
 [ -d /proc/self/task ] || { echo "skipped: no /proc/self/task here"; exit 77; }
 rm -rf "$work" && mkdir -p "$work"
 cat > "$work/config.yaml" <<'YAML'
+fingerprint:
+  workers: 3
 pipeline:
   threads:
+    fingerprint:
+      nice: 3
     lcm_receiver:
       name: tsl-rx-custom
     recorder:
@@ -29,5 +34,8 @@ wait $pid || true
 echo "$found"
 echo "$found" | grep -qx "tsl-rx-custom 0" || { echo "no thread tsl-rx-custom (nice 0)"; cat "$work/daemon.log"; exit 1; }
 echo "$found" | grep -qx "tsl-rec-custom 5" || { echo "no thread tsl-rec-custom (nice 5)"; cat "$work/daemon.log"; exit 1; }
+echo "$found" | grep -qx "tsl-fingerprint 3" || { echo "no thread tsl-fingerprint (nice 3)"; exit 1; }
+echo "$found" | grep -qx "tsl-vpack-1 3" || { echo "no pool thread tsl-vpack-1 (nice 3)"; exit 1; }
+echo "$found" | grep -qx "tsl-vpack-2 3" || { echo "no pool thread tsl-vpack-2 (nice 3)"; exit 1; }
 if echo "$found" | grep -q "tsl-lcm-rx\|tsl-record"; then echo "a default I/O thread name is still used"; exit 1; fi
 echo "io threads as configured"

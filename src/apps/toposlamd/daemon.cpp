@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -64,6 +65,18 @@ LcmChannels channelsOf(const LcmSettings& lcm) {
   return c;
 }
 
+/// The fingerprint stage's pool threads (tsl-vpack-1, ...) take the fingerprint thread's scheduling from
+/// pipeline.threads.fingerprint (policy, priority, nice), so the stage's work runs at one priority. Not its
+/// CPU: the pool exists to run on the other cores. A setting that cannot be applied is logged, not fatal.
+std::function<void(int)> fingerprintWorkers(const ThreadSettings& fingerprint) {
+  return [fingerprint](int worker) {
+    ThreadSettings settings = fingerprint;
+    settings.name = "tsl-vpack-" + std::to_string(worker);
+    settings.cpu = -1;
+    for (const std::string& problem : applyThreadSettings(settings)) spdlog::warn("thread {}", problem);
+  };
+}
+
 /// Everything one run needs, built from the config in dependency order.
 struct Assembly {
   std::unique_ptr<FrameSource> source;
@@ -75,7 +88,8 @@ struct Assembly {
 
   Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri) {
     source = openSource(source_uri);
-    pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers, namedWorkers("tsl-vpack"));
+    pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers,
+                                        fingerprintWorkers(config.pipeline.threads.fingerprint));
     fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get(),
                                                           config.fingerprint_stage.thumbnail_width);
     similarity = std::make_unique<NgramSimilarity>(config.similarity);
