@@ -10,7 +10,8 @@
 //      CandidateSelectionConfig::exhaustive_up_to only with some of them, see there);
 //   3. its weight is the appearance likelihood: for a known node m the max similarity over the
 //      representatives this particle gave m; for a new node eta * (1 - max_m), eta the normalised entropy
-//      of the normalised known-node likelihoods (eq. 5.6/5.7; eta = 1 with a single known node);
+//      of the normalised known-node likelihoods (eq. 5.6/5.7; eta = 1 with a single known node), or
+//      1 - max_m without eta (new_node_entropy = false, the default preset's);
 //   4. systematic resampling; 5. map update: the surviving particles append the representative to their
 //      node, keeping at most max_representatives_per_node (the oldest is dropped).
 //
