@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "benchmarks.hpp"
+#include "lcm_channels.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/worker_pool.hpp"
@@ -165,12 +166,7 @@ RunResult runOnce(const DaemonConfig& base, const PipelineBenchOptions& o, const
   c.pipeline.record_latencies = true;
   c.pipeline.queues.overflow = paced ? QueueOverflow::DropOldest : QueueOverflow::Block;
   SteadyClock clock;
-  LcmChannels channels;
-  channels.place = c.lcm.place_channel;
-  channels.place_event = c.lcm.place_event_channel;
-  channels.topology = c.lcm.topology_channel;
-  channels.status = c.lcm.status_channel;
-  channels.motion = c.lcm.motion_channel;
+  const LcmChannels channels = channelsOf(c.lcm);
   // Every thread of the run (worker pool, stage threads, OpenCV's) is created below and inherits this.
   const std::vector<int> all = allowedCpus();
   if (const std::string problem = restrictToCpus(std::vector<int>(all.begin(), all.begin() + cores)); !problem.empty())

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "lcm_channels.hpp"
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/config/daemon_config.hpp"
@@ -58,16 +59,6 @@ std::vector<std::string> splitChannels(const std::string& text) {
   while (std::getline(in, item, ','))
     if (!item.empty()) out.push_back(item);
   return out;
-}
-
-LcmChannels channelsOf(const LcmSettings& lcm) {
-  LcmChannels c;
-  c.place = lcm.place_channel;
-  c.place_event = lcm.place_event_channel;
-  c.topology = lcm.topology_channel;
-  c.status = lcm.status_channel;
-  c.motion = lcm.motion_channel;
-  return c;
 }
 
 // A --channels item is a channel name of the config or one of its keys (place, place_event, topology,

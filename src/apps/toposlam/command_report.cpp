@@ -21,6 +21,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
+#include "lcm_channels.hpp"
 #include "toposlam/platform/output_file.hpp"
 #include "eval_cli_options.hpp"
 #include "toposlam/core/natural_order.hpp"
@@ -175,12 +176,7 @@ std::string runFolderOf(const std::string& run_dir) {
   if (log.empty()) throw std::invalid_argument("run_dir: 'lcmlog:' names no file (lcmlog:FILE)");
   DaemonConfig config;
   if (const std::string path = defaultDaemonConfigPath(); fs::exists(path)) config = loadDaemonConfig(path);
-  LcmChannels channels;
-  channels.place = config.lcm.place_channel;
-  channels.place_event = config.lcm.place_event_channel;
-  channels.topology = config.lcm.topology_channel;
-  channels.status = config.lcm.status_channel;
-  channels.motion = config.lcm.motion_channel;
+  const LcmChannels channels = channelsOf(config.lcm);
   const LoggedRun run = readLoggedRun(log, channels);
   const std::string folder = log + ".run";
   writeRunFolderFromLog(run, log, folder);

@@ -23,6 +23,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "lcm_channels.hpp"
 #include "sources.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/io/recording_frame_source.hpp"
@@ -53,16 +54,6 @@ std::vector<int> handledSignalNumbers() {
   std::vector<int> signals(std::begin(kStopSignals), std::end(kStopSignals));
   signals.insert(signals.end(), std::begin(kIgnoredSignals), std::end(kIgnoredSignals));
   return signals;
-}
-
-LcmChannels channelsOf(const LcmSettings& lcm) {
-  LcmChannels c;
-  c.place = lcm.place_channel;
-  c.place_event = lcm.place_event_channel;
-  c.topology = lcm.topology_channel;
-  c.status = lcm.status_channel;
-  c.motion = lcm.motion_channel;
-  return c;
 }
 
 /// The fingerprint stage's pool threads (tsl-vpack-1, ...) take the fingerprint thread's scheduling from
