@@ -423,10 +423,9 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("segmentation.doorway_shift_s", AT(segmentation.doorway_shift_s), 7.0, 0, 60, "seconds",
                    "a border moves to the doorway passage nearest it (predicted from the vertical edges) when one is "
                    "at most this far (0 = off, the thesis)"));
-  k.push_back(flag("segmentation.doorway_borders", AT(segmentation.doorway_borders), false,
-                   "with doorway_shift_s > 0: a doorway passage makes a border of its own, and a second border for "
-                   "the passage a place began at is dropped (off: a wrong closure kept on look-alike rooms; "
-                   "docs/segmentation.md)"));
+  k.push_back(flag("segmentation.doorway_borders", AT(segmentation.doorway_borders), true,
+                   "with doorway_shift_s > 0 and window_m 0: a doorway passage makes a border of its own, and a second "
+                   "border for the passage a place began at is dropped (docs/segmentation.md, \"Borders at doorways\")"));
   k.push_back(choice("segmentation.representative", AT(segmentation.representative), RepresentativeChoice::WindowDegree,
                      {{"window-degree", RepresentativeChoice::WindowDegree},
                       {"place-medoid", RepresentativeChoice::PlaceMedoid}},
@@ -453,9 +452,12 @@ std::vector<ConfigKey> makeKeys() {
                    "false: 1 - max L (docs/topology.md, \"The new node's likelihood\")"));
   k.push_back(real("topology.alpha", AT(topology.alpha), 15.0, 0, 1e6, "", "expected number of places (thesis: 15)")
                   .exclusive(true, false));
-  k.push_back(real("topology.new_node_probability", AT(topology.new_node_probability), 0.05, 0, 1, "",
-                   "probability of a new node from a known one (thesis: 0.05)")
+  k.push_back(real("topology.new_node_probability", AT(topology.new_node_probability), 0.02, 0, 1, "",
+                   "probability of a new node from a known one (thesis: 0.05; docs/topology.md, \"Look-alike rooms\")")
                   .exclusive(true, true));
+  k.push_back(real("topology.new_node_likelihood_floor", AT(topology.new_node_likelihood_floor), 0.01, 0, 1, "",
+                   "smallest likelihood of a new node, the chance a new place looks like a stored one (thesis: 0)")
+                  .exclusive(false, true));
   k.push_back(real("topology.gamma_shape", AT(topology.gamma_shape), 5.0, 0, 1000, "",
                    "successor gamma pdf shape (5 and scale 0.4 give staying 0.33, docs/topology.md)")
                   .exclusive(true, false));

@@ -29,6 +29,8 @@ std::string DoorwayPassageConfig::validate() const {
     problem << "pair_tolerance_fraction: " << pair_tolerance_fraction << " is outside the allowed range [0, 1]";
   } else if (!(max_exit_gap_s >= 0.0 && max_exit_gap_s <= 10.0)) {
     problem << "max_exit_gap_s: " << max_exit_gap_s << " is outside the allowed range [0, 10]";
+  } else if (!(max_frame_gap_s > 0.0 && max_frame_gap_s <= 60.0)) {
+    problem << "max_frame_gap_s: " << max_frame_gap_s << " is outside the allowed range (0, 60]";
   }
   return problem.str();
 }
@@ -52,7 +54,15 @@ void DoorwayPassageDetector::addFrame(double time_s, int image_width, const std:
     passages_.clear();
     frame_interval_s_ = 0.0;
   }
-  if (started_ && time_s > last_time_s_) frame_interval_s_ = time_s - last_time_s_;
+  if (started_ && time_s - last_time_s_ > config_.max_frame_gap_s) {
+    // A gap (the robot stood, frames were left out): no track or pending track end carries over, and a
+    // passage predicted beyond the last frame before it assumed the robot kept going.
+    tracks_.clear();
+    exits_.clear();
+    std::erase_if(passages_, [&](double passage_s) { return passage_s > last_time_s_; });
+  } else if (started_ && time_s > last_time_s_) {
+    frame_interval_s_ = time_s - last_time_s_;
+  }
   started_ = true;
   last_time_s_ = time_s;
   if (image_width <= 0) return;

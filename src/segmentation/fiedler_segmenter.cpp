@@ -525,7 +525,7 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
   }
   // A doorway passage the frames have reached closes the open place there, unless a border is already
   // on it (one passage per frame; a place closed by a valley in this frame makes it wait for the next).
-  if (config_.doorway_shift_s > 0.0 && config_.doorway_borders && !step.closed_place) {
+  if (passagesMakeBorders() && !step.closed_place) {
     const std::optional<double> due = doorway_.firstPassageAfter(passages_done_s_);
     if (due && time_s >= *due) {
       passages_done_s_ = *due;
@@ -587,7 +587,7 @@ bool FiedlerSegmenter::moveBorderToDoorway() {
   pending_border_passage_s_ = std::numeric_limits<double>::quiet_NaN();
   const std::optional<double> passage = doorway_.nearestPassage(pending_border_time_s_, config_.doorway_shift_s);
   if (!passage) return true;
-  if (config_.doorway_borders && *passage == place_start_passage_s_) {
+  if (passagesMakeBorders() && *passage == place_start_passage_s_) {
     // The open place began at this doorway: a second border for it is where the view changes again
     // after the door (the robot turning into the corridor). Dropped; the place's representative comes
     // from the frames after it, the view the place settles on.

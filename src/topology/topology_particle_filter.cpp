@@ -139,6 +139,8 @@ std::string TopologyFilterConfig::validate() const {
   if (!(relative_offset >= -10.0 && relative_offset <= 10.0)) return "relative_offset: must be in [-10, 10]";
   if (!(relative_sigma_floor > 0.0 && relative_sigma_floor <= 1.0))
     return "relative_sigma_floor: must be in (0, 1]";
+  if (!(new_node_likelihood_floor >= 0.0 && new_node_likelihood_floor < 1.0))
+    return "new_node_likelihood_floor: must be in [0, 1)";
   if (const std::string problem = candidates.validate(); !problem.empty()) return "candidates." + problem;
   return "";
 }
@@ -335,7 +337,7 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
           const double eta = config_.new_node_entropy
                                  ? entropyFromSums(root.memo_sum, root.memo_sum_l_log_l, g.nodeCount())
                                  : 1.0;
-          stats.new_likelihood = eta * (1.0 - stats.max);
+          stats.new_likelihood = std::max(eta * (1.0 - stats.max), config_.new_node_likelihood_floor);
         }
         phase_ = Phase::Resample;
         cursor_ = 0;
@@ -771,6 +773,8 @@ void FrozenTopologyState::saveState(std::ostream& out) const {
   w.f64(config_.relative_sigma_floor);
   // Second extension block (absent in maps written before it: those used eq. 5.7's entropy).
   w.u8(config_.new_node_entropy ? 1 : 0);
+  // Third extension block (absent in maps written before it: those had no floor).
+  w.f64(config_.new_node_likelihood_floor);
   const std::string& data = w.data();
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
 }
@@ -881,6 +885,7 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     config.relative_offset = r.f64("likelihood model");
     config.relative_sigma_floor = r.f64("likelihood model");
     config.new_node_entropy = r.atEnd() ? true : r.flag("new node likelihood");
+    config.new_node_likelihood_floor = r.atEnd() ? 0.0 : r.f64("new node likelihood floor");
     if (const std::string problem = config.validate(); !problem.empty())
       throw std::runtime_error("map data: bad filter config: " + problem);
   } else {

@@ -113,6 +113,23 @@ TEST_CASE("GIVEN a clock that goes back WHEN frames arrive THEN the passages bef
   CHECK(detector.passageCount() == 1);
 }
 
+TEST_CASE("GIVEN a robot that stands 10 s just before a door WHEN the frames taken standing are left out THEN "
+          "no passage is timed across the gap, and the door after it is found",
+          "[segmentation][doorway]") {
+  // Motion-aware segmentation leaves out the frames taken standing (docs/segmentation.md): the detector
+  // sees the jambs near the image border at 4.4 s, then nothing until the robot drives on at 15.4 s.
+  DoorwayPassageDetector detector;
+  driveThroughDoor(detector, 5.0, 0.0, 4.4, 6.0);
+  REQUIRE(detector.passageCount() == 0);
+  driveThroughDoor(detector, 5.0, 15.4, 24.0, 15.9, {});  // through it, then on towards a wall
+  CHECK_FALSE(detector.nearestPassage(6.0, 3.0).has_value());  // the jambs' tracks did not end at 15.4 s
+  driveThroughDoor(detector, 5.0, 24.2, 33.0, 30.0);           // the next door, driven through
+  const std::optional<double> next = detector.nearestPassage(30.0, 3.0);
+  REQUIRE(next.has_value());
+  CHECK(*next == Approx(30.0).margin(0.25));
+  CHECK(detector.passageCount() == 1);
+}
+
 TEST_CASE("GIVEN bad doorway settings WHEN a detector is made THEN they are refused by name",
           "[segmentation][doorway]") {
   DoorwayPassageConfig config;
@@ -121,6 +138,7 @@ TEST_CASE("GIVEN bad doorway settings WHEN a detector is made THEN they are refu
   SECTION("border_fraction") { config.border_fraction = 1.5; }
   SECTION("max_lookahead_s") { config.max_lookahead_s = 0.0; }
   SECTION("max_exit_gap_s") { config.max_exit_gap_s = -1.0; }
+  SECTION("max_frame_gap_s") { config.max_frame_gap_s = 0.0; }
   const std::string problem = config.validate();
   CHECK_FALSE(problem.empty());
   CHECK_THROWS_WITH(DoorwayPassageDetector(config), Catch::Contains("doorway passage config: ") &&
@@ -271,7 +289,8 @@ namespace {
 /// Appearance blocks beginning at `block_starts` (frames of one block alike, of two blocks not), doors
 /// passed at `doors` (each door's jambs seen from 30 frames before it), 100 frames at 5 fps.
 std::vector<SegmentedPlace> segmentBlocks(double shift_s, const std::vector<int>& block_starts,
-                                          const std::vector<int>& doors, FiedlerSegmenter** out) {
+                                          const std::vector<int>& doors, FiedlerSegmenter** out,
+                                          double window_m = 0.0) {
   const auto blockOf = [block_starts](int f) {
     return static_cast<int>(std::upper_bound(block_starts.begin(), block_starts.end(), f) - block_starts.begin());
   };
@@ -283,6 +302,7 @@ std::vector<SegmentedPlace> segmentBlocks(double shift_s, const std::vector<int>
   FiedlerSegmenterConfig config = toposlam::test::thesisConfig();
   config.doorway_shift_s = shift_s;
   config.doorway_borders = true;
+  config.window_m = window_m;
   static std::unique_ptr<FiedlerSegmenter> keep;
   keep = std::make_unique<FiedlerSegmenter>(config, *similarity);
   std::vector<SegmentedPlace> places;
@@ -327,6 +347,11 @@ TEST_CASE("GIVEN a doorway passage and no border by appearance WHEN segmented TH
     CHECK(places[1].representative_frame >= places[1].first_frame);
     CHECK(segmenter->doorwayBorders() == 1);
     CHECK(segmenter->ignoredValleys() == 0);
+  }
+  SECTION("segmenting by travel (window_m > 0): the passages only move borders, so no border") {
+    CHECK(segmentBlocks(8.0, {}, {50}, &segmenter, 3.0).size() == 1);
+    CHECK(segmenter->doorwayPassages() == 1);
+    CHECK(segmenter->doorwayBorders() == 0);
   }
   SECTION("two doors: two borders, each at its door") {
     const auto places = segmentBlocks(8.0, {}, {35, 70}, &segmenter);

@@ -29,19 +29,27 @@ TEST_CASE(
   filter->saveState(out);
   const std::string state = out.str();
   REQUIRE(state.size() > 100);
-  // The state ends with the likelihood block (u8 + 3 f64) and the new-node block (u8). A state cut just
-  // before either is one written before that block existed: before the likelihood block it loads with the
-  // thesis' absolute likelihood, before the new-node block with eq. 5.7's entropy. Every other cut throws.
+  // The state ends with the likelihood block (u8 + 3 f64), the new-node block (u8) and the new-node floor
+  // block (f64). A state cut just before one is one written before that block existed: before the likelihood
+  // block it loads with the thesis' absolute likelihood, before the new-node block with eq. 5.7's entropy,
+  // before the floor block with no floor. Every other cut throws.
+  constexpr std::size_t kFloorBlock = 8;
   constexpr std::size_t kNewNodeBlock = 1;
   constexpr std::size_t kLikelihoodBlock = 1 + 3 * 8;
   for (std::size_t cut = 0; cut < state.size(); ++cut) {
     std::istringstream in(state.substr(0, cut));
-    if (cut == state.size() - kNewNodeBlock - kLikelihoodBlock) {
+    if (cut == state.size() - kFloorBlock - kNewNodeBlock - kLikelihoodBlock) {
       CHECK(TopologyParticleFilter::loadState(in, sim)->config().likelihood == LikelihoodModel::Absolute);
       continue;
     }
-    if (cut == state.size() - kNewNodeBlock) {
-      CHECK(TopologyParticleFilter::loadState(in, sim)->config().new_node_entropy);
+    if (cut == state.size() - kFloorBlock - kNewNodeBlock) {
+      const auto loaded = TopologyParticleFilter::loadState(in, sim);
+      CHECK(loaded->config().new_node_entropy);
+      CHECK(loaded->config().new_node_likelihood_floor == 0.0);
+      continue;
+    }
+    if (cut == state.size() - kFloorBlock) {
+      CHECK(TopologyParticleFilter::loadState(in, sim)->config().new_node_likelihood_floor == 0.0);
       continue;
     }
     CHECK_THROWS_AS(TopologyParticleFilter::loadState(in, sim), std::runtime_error);
@@ -75,14 +83,17 @@ TEST_CASE(
     }
   }
   INFO("loaded " << loaded << ", refused " << refused << " of " << positions.size());
-  // Measured: 59 flips load (and re-save exactly), 294 are refused (the flag byte among them). The last 300
-  // bytes include the likelihood block, whose slope, offset and floor load whenever they stay in range.
+  // Measured: 66 flips load (and re-save exactly), 287 are refused (the flag byte among them). The last 300
+  // bytes include the likelihood block, whose slope, offset and floor load whenever they stay in range, and
+  // the new node's likelihood floor (0 here): a flip of one of its 7 low bytes is a tiny floor in [0, 1)
+  // and loads, of its top byte a huge one and is refused (before that block: 59 and 294).
   // A change in either count means the loader's validation changed: look at which flips moved.
-  CHECK(loaded == 59);
-  CHECK(refused == 294);
+  CHECK(loaded == 66);
+  CHECK(refused == 287);
 }
 
-TEST_CASE("GIVEN a filter without eq. 5.7's entropy WHEN saved and loaded THEN the loaded one keeps 1 - max L",
+TEST_CASE("GIVEN a filter without eq. 5.7's entropy or with a new node's likelihood floor WHEN saved and loaded "
+          "THEN the loaded one keeps them",
           "[topology][map]") {
   auto sim = placeSimilarity();
   for (const bool entropy : {false, true}) {
@@ -90,6 +101,7 @@ TEST_CASE("GIVEN a filter without eq. 5.7's entropy WHEN saved and loaded THEN t
     config.particles = 50;
     config.likelihood = LikelihoodModel::Relative;
     config.new_node_entropy = entropy;
+    config.new_node_likelihood_floor = entropy ? 0.0 : 0.01;
     TopologyParticleFilter filter(config, sim);
     for (int k = 0; k < 6; ++k) filter.step(taggedFingerprint(k % 3));
     std::ostringstream out;
@@ -97,6 +109,7 @@ TEST_CASE("GIVEN a filter without eq. 5.7's entropy WHEN saved and loaded THEN t
     std::istringstream in(out.str());
     auto loaded = TopologyParticleFilter::loadState(in, sim);
     CHECK(loaded->config().new_node_entropy == entropy);
+    CHECK(loaded->config().new_node_likelihood_floor == config.new_node_likelihood_floor);
     // The loaded filter steps as the original does.
     filter.step(taggedFingerprint(1));
     loaded->step(taggedFingerprint(1));

@@ -477,3 +477,67 @@ TEST_CASE(
   CHECK(alternatives_checked > 20);
   CHECK(best_changed_lineage > 0);  // the memo's shared prefix was not always the whole last best
 }
+
+TEST_CASE(
+    "GIVEN a place that looks exactly like a stored one WHEN a new node's likelihood has a floor THEN the closure is "
+    "proposed and the next place undoes it, and without the floor it is kept",
+    "[topology][relative]") {
+  // The look-alike rooms (docs/topology.md, "Look-alike rooms"): places 0-5 differ, place 6 is place 0's twin
+  // (relative likelihood ~1 for node 0), place 7 matches nothing. From node 0 the next place should be node 1;
+  // from a new node, "new" is what eq. 5.8 expects.
+  const test::TagSimilarity sim([](int a, int b) {
+    if (a == b) return 1.0;
+    if (std::min(a, b) == 0 && std::max(a, b) == 6) return 0.6;
+    return 0.02 + 0.01 * ((a * 7 + b * 3) % 5);
+  });
+  const auto lap = [&](double new_node_probability, double floor) {
+    TopologyFilterConfig config = configWith(500, 1);
+    config.likelihood = LikelihoodModel::Relative;
+    config.relative_slope = 2.0;
+    config.relative_offset = 4.25;
+    config.new_node_entropy = false;
+    config.gamma_shape = 5.0;
+    config.gamma_scale = 0.4;
+    config.new_node_probability = new_node_probability;
+    config.new_node_likelihood_floor = floor;
+    TopologyParticleFilter filter(config, sim);
+    run(filter, {0, 1, 2, 3, 4, 5, 6});
+    const TopologyEstimate at_twin = filter.estimate(0);
+    double kept_new = 0.0;  // share of particles that hold place 6 as a node of its own
+    for (const LocationHypothesis& h : at_twin.locations)
+      if (h.founding_observation == 6) kept_new = h.probability;
+    filter.step(taggedFingerprint(7));
+    const TopologyEstimate after = filter.estimate(0);
+    REQUIRE(after.best.assignment.size() == 8);
+    struct Outcome {
+      int proposed;       // place 6's node in the best topology at its own step
+      double kept_new;
+      bool undone;        // after place 7, place 6 is not on place 0's node
+    };
+    return Outcome{at_twin.best.assignment.back(), kept_new,
+                   after.best.assignment[6] != after.best.assignment[0]};
+  };
+  // The default preset's 0.02 and 0.01: the closure is proposed, about 1 particle in 10 keeps "new", and the
+  // place after it moves the best topology there.
+  const auto with_floor = lap(0.02, 0.01);
+  CHECK(with_floor.proposed == 0);
+  CHECK(with_floor.kept_new > 0.03);
+  CHECK(with_floor.kept_new < 0.5);
+  CHECK(with_floor.undone);
+  // No floor (the thesis): a known node at L ~ 1 leaves "new" ~1e-4 of the weight; no particle keeps it.
+  const auto without = lap(0.05, 0.0);
+  CHECK(without.proposed == 0);
+  CHECK(without.kept_new < 0.01);
+  CHECK_FALSE(without.undone);
+}
+
+TEST_CASE("GIVEN a new node's likelihood floor below 0, at 1 or not a number WHEN validated THEN the key is named",
+          "[topology]") {
+  TopologyFilterConfig config;
+  for (const double bad : {-0.01, 1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    config.new_node_likelihood_floor = bad;
+    CHECK(config.validate() == "new_node_likelihood_floor: must be in [0, 1)");
+  }
+  config.new_node_likelihood_floor = 0.0;
+  CHECK(config.validate().empty());
+}

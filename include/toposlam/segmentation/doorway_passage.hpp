@@ -52,6 +52,10 @@ struct DoorwayPassageConfig {
   /// ... and their tracks left the image at most this far apart (seconds): both jambs of a doorway pass
   /// out of view together, two edges that merely happen to predict the same moment seldom do.
   double max_exit_gap_s = 0.5;
+  /// Frames further apart than this (seconds: frames left out while the robot stood, a capture stall)
+  /// end every track, and a passage predicted after the frame before the gap is forgotten: an edge cannot
+  /// be followed across the gap, and the robot did not keep going at the speed the prediction assumed.
+  double max_frame_gap_s = 1.5;
   /// Returns "" when valid, else "<field>: <problem, allowed range>".
   std::string validate() const;
 };

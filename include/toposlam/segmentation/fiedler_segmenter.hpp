@@ -113,10 +113,12 @@ struct FiedlerSegmenterConfig {
   /// appearance moves to the passage nearest to it when one is at most this many seconds away. Allowed
   /// [0, 60]; 0 = off (the thesis).
   double doorway_shift_s = 0.0;
-  /// With doorway_shift_s > 0, passages also make borders: a passage the frames reach closes the open
-  /// place there (unless a border is on it already), and a border whose nearest passage is the one the
-  /// open place began at is dropped (one border per doorway). Off by default (docs/segmentation.md:
-  /// better boundary F1 on the simulated office and home, but a wrong closure kept on look-alike rooms).
+  /// With doorway_shift_s > 0 and segmentation by time (window_m 0), passages also make borders: a
+  /// passage the frames reach closes the open place there (unless a border is on it already), and a
+  /// border whose nearest passage is the one the open place began at is dropped (one border per doorway).
+  /// With window_m > 0 the passages only move borders: they are timed on the clock, assuming the robot
+  /// keeps its speed, which segmenting by travel is there not to assume (docs/segmentation.md). Off here
+  /// (the thesis); on in the default preset.
   bool doorway_borders = false;
   /// The representative rule; both prefer frames with at least min_keypoints keypoints.
   RepresentativeChoice representative = RepresentativeChoice::WindowDegree;
@@ -206,6 +208,10 @@ class FiedlerSegmenter {
   Eigen::MatrixXd affinityInWindowOrder() const;
 
  private:
+  /// doorway_borders in effect: rules 1 and 3 of docs/segmentation.md, by time only (see the config).
+  bool passagesMakeBorders() const {
+    return config_.doorway_shift_s > 0.0 && config_.doorway_borders && !(config_.window_m > 0.0);
+  }
   struct Candidate {
     std::int64_t frame;
     double degree;

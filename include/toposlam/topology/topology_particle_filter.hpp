@@ -115,6 +115,12 @@ struct TopologyFilterConfig {
   /// the particles (docs/topology.md, "The new node's likelihood"). Saved with the map; maps written
   /// before it existed load with it on.
   bool new_node_entropy = true;
+  /// Smallest likelihood of a new node: max(eta (1 - max L), floor), the probability that a new place
+  /// looks like a stored one (perceptual aliasing). 0 (the thesis): a known node at L ~ 1 leaves a new
+  /// node ~1e-4 of the weight, so on look-alike rooms no particle keeps the right branch and the places
+  /// after it cannot undo the wrong closure (docs/topology.md, "Look-alike rooms"). Saved with the map;
+  /// maps written before it existed load with 0. Allowed [0, 1).
+  double new_node_likelihood_floor = 0.0;
   /// Not part of the saved state (a loaded map has the defaults until setCandidateSelection()).
   CandidateSelectionConfig candidates;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".

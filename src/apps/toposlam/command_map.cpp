@@ -90,6 +90,10 @@ struct MapOptions {
   bool new_node_entropy = methodPreset("default").topology.new_node_entropy;
   CLI::Option* entropy_given = nullptr;
   CLI::Option* floor_given = nullptr;
+  double new_node_probability = methodPreset("default").topology.new_node_probability;
+  CLI::Option* new_node_probability_given = nullptr;
+  double new_node_likelihood_floor = methodPreset("default").topology.new_node_likelihood_floor;
+  CLI::Option* new_node_floor_given = nullptr;
 };
 
 /// Per observation of the map (this run's and earlier runs'): where it came from.
@@ -239,6 +243,8 @@ StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const 
   if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
   if (o.entropy_given->count() > 0) config.new_node_entropy = o.new_node_entropy;
   if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
+  if (o.new_node_probability_given->count() > 0) config.new_node_probability = o.new_node_probability;
+  if (o.new_node_floor_given->count() > 0) config.new_node_likelihood_floor = o.new_node_likelihood_floor;
   config.candidates = o.candidates;
   if (const std::string problem = config.validate(); !problem.empty())
     throw std::invalid_argument("map: " + problem);
@@ -712,6 +718,15 @@ void addMapCommand(CLI::App& app) {
   options->floor_given = cmd->add_option("--relative-sigma-floor", options->relative_sigma_floor,
                                          "Relative likelihood: smallest spread of the other similarities")
                              ->capture_default_str();
+  options->new_node_probability_given =
+      cmd->add_option("--new-node-probability", options->new_node_probability,
+                      "Filter: probability of a new node from a known one, (0, 1) (thesis: 0.05)")
+          ->capture_default_str();
+  options->new_node_floor_given =
+      cmd->add_option("--new-node-likelihood-floor", options->new_node_likelihood_floor,
+                      "Filter: smallest likelihood of a new node (perceptual aliasing), [0, 1) (thesis: 0; "
+                      "docs/topology.md, \"Look-alike rooms\")")
+          ->capture_default_str();
   cmd->add_option("--exhaustive-up-to", options->candidates.exhaustive_up_to,
                   "A new place is compared with every stored representative up to this many; above, with the "
                   "candidate index's top only (docs/topology.md, \"Large maps\")")
