@@ -140,6 +140,7 @@ SCENARIO("Bad configs are refused with the key's full name and the allowed range
       {"topology: {particles: 0}", "topology.particles: 0 is out of range, allowed 1 .. 1000000"},
       {"topology: {particles: lots}", "topology.particles: expected an integer in 1 .. 1000000, got 'lots'"},
       {"topology: {new_node_probability: 1}", "topology.new_node_probability: 1 is out of range, allowed (0, 1)"},
+      {"topology: {new_node_likelihood_floor: 1}", "topology.new_node_likelihood_floor: 1 is out of range, allowed [0, 1)"},
       {"topology: {max_successors: 9}", "topology.max_successors: 9 is out of range, allowed 1 .. 8"},
       {"topology: {seed: -1}", "topology.seed: -1 is out of range"},
       {"topology: {slice_items: 0}", "topology.slice_items: 0 is out of range, allowed 1 .. 1000000 work items"},
@@ -215,9 +216,17 @@ SCENARIO("GIVEN preset: thesis WHEN the config is read THEN every stage takes th
   CHECK(c.segmentation.valley.delta == 0.25);
   CHECK(c.segmentation.cut_placement == CutPlacement::ValleyFrame);
   CHECK(c.topology.likelihood == LikelihoodModel::Absolute);
+  CHECK(c.topology.new_node_probability == 0.05);
+  CHECK(c.topology.new_node_likelihood_floor == 0.0);
+  CHECK(c.topology.new_node_entropy);
+  CHECK_FALSE(c.segmentation.doorway_borders);
+  CHECK(c.segmentation.doorway_shift_s == 0.0);
   const DaemonConfig d = parseDaemonConfig("source: \"sim:office\"\n");
   CHECK(d.preset == "default");
   CHECK(d.topology.likelihood == LikelihoodModel::Relative);
   CHECK(d.segmentation.window_s == 6.0);
+  CHECK(d.topology.new_node_probability == 0.02);
+  CHECK(d.topology.new_node_likelihood_floor == 0.01);
+  CHECK(d.segmentation.doorway_borders);
   CHECK_THROWS_WITH(parseDaemonConfig("preset: fancy\n"), Catch::Contains("preset") && Catch::Contains("thesis"));
 }
