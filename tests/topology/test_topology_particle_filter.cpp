@@ -33,6 +33,16 @@ void run(TopologyParticleFilter& filter, const std::vector<int>& places) {
   for (int p : places) filter.step(taggedFingerprint(p));
 }
 
+/// The relative likelihood of the default preset's kind: slope 2, the given offset, eq. 5.7's entropy or not.
+TopologyFilterConfig relativeConfig(double offset, bool entropy) {
+  TopologyFilterConfig config = configWith(500, 1);
+  config.likelihood = LikelihoodModel::Relative;
+  config.relative_slope = 2.0;
+  config.relative_offset = offset;
+  config.new_node_entropy = entropy;
+  return config;
+}
+
 std::string stateBytes(const TopologyParticleFilter& filter) {
   std::ostringstream out;
   filter.saveState(out);
@@ -366,12 +376,7 @@ TEST_CASE(
     return 0.01 + 0.01 * ((a * 7 + b * 3) % 5);
   });
   const auto lastStep = [&](bool entropy, double offset) {
-    TopologyFilterConfig config = configWith(500, 1);
-    config.likelihood = LikelihoodModel::Relative;
-    config.relative_slope = 2.0;
-    config.relative_offset = offset;
-    config.new_node_entropy = entropy;
-    TopologyParticleFilter filter(config, sim);
+    TopologyParticleFilter filter(relativeConfig(offset, entropy), sim);
     run(filter, {0, 1, 2, 3, 4, 5, 6});
     const TopologyEstimate e = filter.estimate(0);
     REQUIRE(e.best.assignment.size() == 7);
@@ -491,11 +496,7 @@ TEST_CASE(
     return 0.02 + 0.01 * ((a * 7 + b * 3) % 5);
   });
   const auto lap = [&](double new_node_probability, double floor) {
-    TopologyFilterConfig config = configWith(500, 1);
-    config.likelihood = LikelihoodModel::Relative;
-    config.relative_slope = 2.0;
-    config.relative_offset = 4.25;
-    config.new_node_entropy = false;
+    TopologyFilterConfig config = relativeConfig(4.25, false);
     config.gamma_shape = 5.0;
     config.gamma_scale = 0.4;
     config.new_node_probability = new_node_probability;
