@@ -528,8 +528,13 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
   if (passagesMakeBorders() && !step.closed_place) {
     const std::optional<double> due = doorway_.firstPassageAfter(passages_done_s_);
     if (due && time_s >= *due) {
-      passages_done_s_ = *due;
-      step.closed_place = closePlaceAtPassage(*due);
+      // A valley the passage interrupts closes its place first; the passage closes the next one at the
+      // next frame (it is still due then).
+      step.closed_place = closePlaceAtInterruptedValley(*due);
+      if (!step.closed_place) {
+        passages_done_s_ = *due;
+        step.closed_place = closePlaceAtPassage(*due);
+      }
     }
   }
   return step;
@@ -575,6 +580,37 @@ std::optional<SegmentedPlace> FiedlerSegmenter::closePlaceAtPassage(double passa
   if (!hasCandidateIn(from, to)) return std::nullopt;
   SegmentedPlace place = closePlace(at.border, at.last, at.last_time_s, at.border, at.border_time_s, passage_s);
   ++doorway_borders_;
+  return place;
+}
+
+std::optional<SegmentedPlace> FiedlerSegmenter::closePlaceAtInterruptedValley(double passage_s) {
+  // A valley whose fall is confirmed (a peak, then lambda2 down by delta) but whose rise is not yet:
+  // its border candidate is inside the open place, before the passage.
+  if (detector_.lookingForPeak() || pending_min_frame_ < 0 || pending_min_frame_ != detector_.minIndex()) {
+    return std::nullopt;
+  }
+  if (pending_border_frame_ <= place_start_ || passage_s == place_start_passage_s_) return std::nullopt;
+  const RecentBorder at = recentBorderAt(passage_s);
+  if (at.border < 0 || at.last < 0 || pending_border_frame_ >= at.border) return std::nullopt;
+  // Both places must span a window: a shorter stretch is the view changing on the way to the door (the
+  // door's own valley, which the passage's border stands for), or a stretch no window could find alone.
+  if (config_.window_s > 0.0) {
+    const double tolerance = 1e-6 * config_.window_s;
+    if (pending_border_time_s_ - place_start_time_s_ < config_.window_s - tolerance) return std::nullopt;
+    if (at.border_time_s - pending_border_time_s_ < config_.window_s - tolerance) return std::nullopt;
+  } else if (pending_border_frame_ - place_start_ < config_.window || at.border - pending_border_frame_ < config_.window) {
+    return std::nullopt;
+  }
+  const std::int64_t from = std::max(place_start_, representative_from_);
+  if (!hasCandidateIn(from, std::min(pending_last_frame_, representative_last_))) return std::nullopt;
+  if (!hasCandidateIn(pending_border_frame_, at.last)) return std::nullopt;
+  SegmentedPlace place = closePlace(pending_min_frame_, pending_last_frame_, pending_last_time_s_, pending_border_frame_,
+                                    pending_border_time_s_, std::numeric_limits<double>::quiet_NaN());
+  // The passage takes the valley's rise: look for the next peak from here.
+  detector_.reset();
+  pending_min_frame_ = -1;
+  pending_border_frame_ = -1;
+  ++interrupted_valleys_;
   return place;
 }
 

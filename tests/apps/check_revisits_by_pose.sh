@@ -2,7 +2,7 @@
 # Place-level loop closures on the simulated office judged by the camera's pose (docs/evaluation.md,
 # "Place revisits by pose"; issue 14's targets): two laps by day, then a day lap followed by a night lap.
 # Fails when fewer than 90 % of the two-lap run's revisits (measured 11 of 12) or fewer than half of the
-# day-night run's revisits (measured 7 of 11) are closed onto the node of a place they revisit, or when
+# day-night run's revisits (measured 8 of 12) are closed onto the node of a place they revisit, or when
 # either run makes a wrong closure (measured 0 and 0).
 # Usage: check_revisits_by_pose.sh TOPOSLAM OUT_DIR
 set -eu

@@ -389,3 +389,64 @@ TEST_CASE("GIVEN two borders by appearance for one doorway WHEN segmented THEN t
     CHECK(segmenter->doorwayRepeats() == 1);  // the border at 40, 0.8 s after the door
   }
 }
+
+namespace {
+
+/// Frames 0-39 alike (a room); from frame 40 the view keeps changing (the robot turns, then drives on:
+/// a frame is like its near neighbours only), so lambda2 falls at 40 (to 0.19 at frame 53) and rises
+/// to 0.26 only, less than delta: the valley is never confirmed. A door passed at `door` (its jambs
+/// seen from 30 frames before). 100 frames at 5 fps, a window of 25 frames (5 s).
+std::vector<SegmentedPlace> segmentTurnBeforeDoor(int door, bool doorway_borders, FiedlerSegmenter** out) {
+  static const HeightTable similarity([](int a, int b) {
+    if ((a < 40) != (b < 40)) return 0.05;
+    if (a < 40) return 0.9 + 0.05 * std::sin(0.7 * a + 1.3 * b);
+    return 0.9 * std::exp(-std::abs(a - b) / 4.0);
+  });
+  FiedlerSegmenterConfig config = toposlam::test::thesisConfig();
+  config.doorway_shift_s = 7.0;
+  config.doorway_borders = doorway_borders;
+  static std::unique_ptr<FiedlerSegmenter> keep;
+  keep = std::make_unique<FiedlerSegmenter>(config, similarity);
+  std::vector<SegmentedPlace> places;
+  for (int f = 0; f < 100; ++f) {
+    if (auto step = keep->addFrame(f, 0.2 * f, doorFrame(f, door <= f + 30 ? door : -1)); step.closed_place)
+      places.push_back(*step.closed_place);
+  }
+  if (auto last = keep->flush()) places.push_back(*last);
+  *out = keep.get();
+  return places;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a valley still pending when the robot reaches a door WHEN segmented THEN its border closes a place first",
+          "[segmentation][doorway]") {
+  // The home's lap: the robot turns on the spot in the corridor (lambda2 falls and stays low while it
+  // turns and drives on), then passes a door before the valley's rise is confirmed.
+  FiedlerSegmenter* segmenter = nullptr;
+  SECTION("moves only (doorway_borders off): the valley is never confirmed, one place") {
+    CHECK(firstFrames(segmentTurnBeforeDoor(80, false, &segmenter)) == std::vector<std::int64_t>{0});
+  }
+  SECTION("on, the door 8 s after the valley's border: a place ends at the border, the next at the door") {
+    const auto places = segmentTurnBeforeDoor(80, true, &segmenter);
+    REQUIRE(places.size() == 3);
+    CHECK(places[1].first_frame == 40);
+    CHECK(places[2].first_frame == Approx(80).margin(1));
+    CHECK(places[0].last_frame == 39);
+    CHECK(places[1].last_frame == places[2].first_frame - 1);
+    CHECK(segmenter->interruptedValleys() == 1);
+    CHECK(segmenter->doorwayBorders() == 1);
+    THEN("each place's representative is from its own frames") {
+      CHECK(places[0].representative_frame < 40);
+      CHECK(places[1].representative_frame >= 40);
+      CHECK(places[1].representative_frame < places[2].first_frame);
+    }
+  }
+  SECTION("on, the door 4 s after the valley's border (less than a window): the door's border alone") {
+    const auto places = segmentTurnBeforeDoor(60, true, &segmenter);
+    REQUIRE(places.size() == 2);
+    CHECK(places[1].first_frame == Approx(60).margin(1));
+    CHECK(segmenter->interruptedValleys() == 0);
+    CHECK(segmenter->doorwayBorders() == 1);
+  }
+}

@@ -114,8 +114,10 @@ struct FiedlerSegmenterConfig {
   /// [0, 60]; 0 = off (the thesis).
   double doorway_shift_s = 0.0;
   /// With doorway_shift_s > 0 and segmentation by time (window_m 0), passages also make borders: a
-  /// passage the frames reach closes the open place there (unless a border is on it already), and a
-  /// border whose nearest passage is the one the open place began at is dropped (one border per doorway).
+  /// passage the frames reach closes the open place there (unless a border is on it already), a valley
+  /// still pending when it does (lambda2 fell, has not risen yet, both sides a window long) closes the
+  /// place at its own border first, and a border whose nearest passage is the one the open place began
+  /// at is dropped (one border per doorway).
   /// With window_m > 0 the passages only move borders: they are timed on the clock, assuming the robot
   /// keeps its speed, which segmenting by travel is there not to assume (docs/segmentation.md). Off here
   /// (the thesis); on in the default preset.
@@ -203,6 +205,9 @@ class FiedlerSegmenter {
   std::int64_t doorwayShifts() const { return doorway_shifts_; }
   std::int64_t doorwayRepeats() const { return doorway_repeats_; }
   std::int64_t doorwayBorders() const { return doorway_borders_; }
+  /// doorway_borders: places closed at a pending valley's border because a passage came before the
+  /// valley's rise (rule 4).
+  std::int64_t interruptedValleys() const { return interrupted_valleys_; }
   std::int64_t doorwayPassages() const { return doorway_.passageCount(); }
   /// Current cached affinity matrix, rows/columns in window order (oldest first); for tests and plots.
   Eigen::MatrixXd affinityInWindowOrder() const;
@@ -253,6 +258,11 @@ class FiedlerSegmenter {
   /// doorway_borders: a passage the frames have reached closes the open place at the first recent frame
   /// at or after it, unless the place began there (a border was moved to it) or after it.
   std::optional<SegmentedPlace> closePlaceAtPassage(double passage_s);
+  /// doorway_borders: a passage the frames have reached while a valley is pending (lambda2 fell by delta
+  /// and has not risen yet) closes the open place at the valley's border first, when both the place
+  /// before that border and the stretch from it to the passage span a window (docs/segmentation.md,
+  /// rule 4). None otherwise.
+  std::optional<SegmentedPlace> closePlaceAtInterruptedValley(double passage_s);
   struct RecentBorder {
     std::int64_t border = -1;  ///< first recent frame at or after the time; -1 = none
     double border_time_s = 0.0;
@@ -325,6 +335,7 @@ class FiedlerSegmenter {
   std::int64_t doorway_shifts_ = 0;
   std::int64_t doorway_repeats_ = 0;
   std::int64_t doorway_borders_ = 0;
+  std::int64_t interrupted_valleys_ = 0;
   /// Passages up to this time are handled (reached by the frames); -inf: none yet.
   double passages_done_s_ = -std::numeric_limits<double>::infinity();
   /// The passage the open place began at (NaN: it began at no passage).
