@@ -538,7 +538,7 @@ std::string renderReportHtml(const ReportInputs& in) {
   html << "<div>" << inlineSvg(lambda2Plot(in)) << "</div>\n";
   if (!run.places.empty()) {
     html << "<h2>Places and their representatives</h2>\n<table class=\"eval\"><tr><th>place</th><th>frames</th>"
-            "<th>representative</th><th>node</th>"
+            "<th>representative</th><th>node</th><th>ended by</th>"
          << (in.rooms.size() == n ? "<th>true room (share of its frames)</th>" : "") << "</tr>\n";
     for (const auto& p : run.places) {
       html << "<tr><td>" << p.place << "</td><td>" << p.first << "-" << p.last << "</td><td>";
@@ -546,7 +546,8 @@ std::string renderReportHtml(const ReportInputs& in) {
       if (rep < in.thumbnails.size() && !in.thumbnails[rep].empty())
         html << "<img src=\"" << in.thumbnails[rep] << "\" alt=\"frame " << p.representative
              << "\" style=\"width:96px;height:72px;object-fit:cover;vertical-align:middle\"> ";
-      html << p.representative << "</td><td>" << (p.node >= 0 ? std::to_string(p.node) : "-") << "</td>";
+      html << p.representative << "</td><td>" << (p.node >= 0 ? std::to_string(p.node) : "-") << "</td><td>"
+           << (p.end.empty() ? std::string("-") : escapeMarkup(p.end)) << "</td>";
       if (in.rooms.size() == n) {
         const std::vector<int> rooms(in.rooms.begin() + p.first, in.rooms.begin() + p.last + 1);
         const int room = majority(rooms);

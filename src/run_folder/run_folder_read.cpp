@@ -210,7 +210,7 @@ std::vector<PlaceRecord> loadPlaces(const std::string& path) {
   const CsvTable t = readCsv(path);
   const int place = t.column("place"), first = t.column("first"), last = t.column("last"),
             rep = t.column("representative"), kp = t.column("keypoints", false),
-            node = t.column("node", false);
+            node = t.column("node", false), end = t.column("end", false);
   std::vector<PlaceRecord> rows;
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     PlaceRecord row;
@@ -223,6 +223,7 @@ std::vector<PlaceRecord> loadPlaces(const std::string& path) {
     row.node = node >= 0 && !t.rows[r][static_cast<std::size_t>(node)].empty()
                    ? static_cast<int>(t.integer(r, node))
                    : -1;
+    if (end >= 0) row.end = t.rows[r][static_cast<std::size_t>(end)];
     if (row.first < 0 || row.first > row.last || row.representative < row.first ||
         row.representative > row.last) {
       throw RunFileError(where(t, r) + ": need 0 <= first <= representative <= last, got " +

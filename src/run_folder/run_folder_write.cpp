@@ -40,10 +40,10 @@ std::int64_t nodeOf(const std::vector<std::int64_t>& place_nodes, std::int64_t p
 
 void writePlaceRows(const fs::path& path, const std::vector<PlaceRecord>& rows) {
   OutputFile out(path);
-  out << "place,first,last,representative,keypoints,node\n";
+  out << "place,first,last,representative,keypoints,node,end\n";
   for (const PlaceRecord& p : rows)
     out << p.place << ',' << p.first << ',' << p.last << ',' << p.representative << ',' << p.keypoints << ','
-        << p.node << '\n';
+        << p.node << ',' << csvField(p.end) << '\n';
   out.commit();
 }
 
@@ -86,6 +86,7 @@ std::vector<PlaceRecord> placeRows(const std::vector<SegmentedPlace>& places,
     row.representative = p.representative_frame;
     row.keypoints = p.representative_keypoints;
     row.node = p.dropped ? -1 : static_cast<int>(nodeOf(place_nodes, p.index));
+    row.end = placeEndName(p.end);
     rows.push_back(row);
   }
   return rows;

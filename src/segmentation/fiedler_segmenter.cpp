@@ -73,6 +73,17 @@ RepresentativeChoice parseRepresentativeChoice(const std::string& name) {
   throw std::invalid_argument("representative '" + name + "' is unknown: use window-degree or place-medoid");
 }
 
+const char* placeEndName(PlaceEnd end) {
+  switch (end) {
+    case PlaceEnd::Valley: return "valley";
+    case PlaceEnd::ValleyAtDoorway: return "valley_at_doorway";
+    case PlaceEnd::DoorwayPassage: return "doorway";
+    case PlaceEnd::InterruptedValley: return "interrupted_valley";
+    case PlaceEnd::StreamEnd: return "stream_end";
+  }
+  return "unknown";
+}
+
 double maxFiedlerValue(int nodes) {
   if (nodes < 2) return 0.0;
   return static_cast<double>(nodes) / static_cast<double>(nodes - 1);
@@ -512,6 +523,8 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
         if (config_.doorway_shift_s <= 0.0 || moveBorderToDoorway()) {
           step.closed_place = closePlace(*valley, pending_last_frame_, pending_last_time_s_, pending_border_frame_,
                                          pending_border_time_s_, pending_border_passage_s_);
+          step.closed_place->end =
+              std::isnan(pending_border_passage_s_) ? PlaceEnd::Valley : PlaceEnd::ValleyAtDoorway;
         } else {
           ++ignored_valleys_;
           ++doorway_repeats_;
@@ -579,6 +592,7 @@ std::optional<SegmentedPlace> FiedlerSegmenter::closePlaceAtPassage(double passa
   const std::int64_t to = std::min(at.last, representative_last_);
   if (!hasCandidateIn(from, to)) return std::nullopt;
   SegmentedPlace place = closePlace(at.border, at.last, at.last_time_s, at.border, at.border_time_s, passage_s);
+  place.end = PlaceEnd::DoorwayPassage;
   ++doorway_borders_;
   return place;
 }
@@ -606,6 +620,7 @@ std::optional<SegmentedPlace> FiedlerSegmenter::closePlaceAtInterruptedValley(do
   if (!hasCandidateIn(pending_border_frame_, at.last)) return std::nullopt;
   SegmentedPlace place = closePlace(pending_min_frame_, pending_last_frame_, pending_last_time_s_, pending_border_frame_,
                                     pending_border_time_s_, std::numeric_limits<double>::quiet_NaN());
+  place.end = PlaceEnd::InterruptedValley;
   // The passage takes the valley's rise: look for the next peak from here.
   detector_.reset();
   pending_min_frame_ = -1;
@@ -708,6 +723,7 @@ std::optional<SegmentedPlace> FiedlerSegmenter::flush() {
   if (place_start_ < 0 || place_start_ > last_frame_) return std::nullopt;
   rememberBestWindowFrame(place_start_, last_frame_ + 1);
   SegmentedPlace place = closePlace(-1, last_frame_, last_time_s_, -1, 0.0, std::numeric_limits<double>::quiet_NaN());
+  place.end = PlaceEnd::StreamEnd;
   place_start_ = -1;  // the next frame added opens a new place
   pending_min_frame_ = -1;
   pending_border_frame_ = -1;

@@ -73,7 +73,7 @@ TEST_CASE("GIVEN the sample frames WHEN `toposlam segment` runs THEN it writes t
   std::ifstream places(out / "places.csv");
   std::string header;
   std::getline(places, header);
-  CHECK(header == "place,first,last,representative,keypoints,node");
+  CHECK(header == "place,first,last,representative,keypoints,node,end");
   fs::remove_all(out);
 }
 

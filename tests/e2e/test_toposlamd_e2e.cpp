@@ -110,12 +110,12 @@ std::vector<OfflinePlace> offlineMap(const std::string& uri, const fs::path& dir
   if (std::system(command.c_str()) != 0) return places;
   std::ifstream in(dir / "places.csv");
   std::string line;
-  std::getline(in, line);  // place,first,last,representative,keypoints,node
+  std::getline(in, line);  // place,first,last,representative,keypoints,node,end
   while (std::getline(in, line)) {
     std::istringstream row(line);
     std::string cell;
     std::vector<std::int64_t> v;
-    while (std::getline(row, cell, ',')) v.push_back(std::stoll(cell));
+    while (v.size() < 6 && std::getline(row, cell, ',')) v.push_back(std::stoll(cell));
     if (v.size() == 6) places.push_back(OfflinePlace{v[1], v[2], v[3], v[5]});
   }
   return places;

@@ -44,6 +44,8 @@ SCENARIO(
       "png;base64,"
       "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8DwHwAFBQIAX8jx0gAAAABJRU5ErkJggg==";
   for (std::int64_t f : wanted) in.thumbnails[static_cast<std::size_t>(f)] = pixel;
+  in.run.places[1].end = "doorway";  // the fixture's places.csv predates the column: "-" for the others
+  in.run.places[2].end = "<b>";      // a damaged file's text is shown as text
   in.generator = "toposlam 9.9.9";
   in.generated = "2026-12-02 10:00 UTC";
   in.pictures.emplace_back("floor plan and route", pixel);
@@ -58,6 +60,10 @@ SCENARIO(
   CHECK_THAT(html, Contains("true rooms:"));
   CHECK_THAT(html, Contains("Frames per node (rows) and true room"));
   CHECK_THAT(html, Contains("<h2>Places and their representatives</h2>"));
+  CHECK_THAT(html, Contains("<th>ended by</th>"));
+  CHECK_THAT(html, Contains("</td><td>-</td>"));
+  CHECK_THAT(html, Contains("</td><td>doorway</td>"));
+  CHECK_THAT(html, Contains("</td><td>&lt;b&gt;</td>"));
   CHECK_THAT(html, Contains("<figcaption>floor plan and route</figcaption>"));
   CHECK_THAT(html, Contains("<p id=\"image-check\" hidden>"));
   CHECK_THAT(html, Contains("Figure 4.10"));

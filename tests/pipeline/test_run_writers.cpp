@@ -77,14 +77,15 @@ TEST_CASE(
   CHECK(frames[101].substr(frames[101].size() - 4) == ",1,9");
   const auto places = linesOf(dir / "places.csv");
   REQUIRE(places.size() == 3);
-  CHECK(places[0] == "place,first,last,representative,keypoints,node");
+  CHECK(places[0] == "place,first,last,representative,keypoints,node,end");
   CHECK(places[1].rfind("0,0,39,", 0) == 0);
   CHECK(places[2].rfind("1,80,119,", 0) == 0);
-  CHECK(places[2].substr(places[2].size() - 5) == ",40,9");
+  CHECK(places[1].substr(places[1].size() - 7) == ",valley");  // closed by the valley after block 0
+  CHECK(places[2].substr(places[2].size() - 16) == ",40,9,stream_end");
   const auto dropped = linesOf(dir / "dropped_places.csv");
   REQUIRE(dropped.size() == 2);
   CHECK(dropped[1].rfind("0,40,79,", 0) == 0);
-  CHECK(dropped[1].substr(dropped[1].size() - 5) == ",3,-1");
+  CHECK(dropped[1].substr(dropped[1].size() - 12) == ",3,-1,valley");
 
   THEN("the lambda2 plot has one series and a dashed line at each of the two valley-closed borders") {
     const toposlam::SvgPlot plot = toposlam::lambda2Plot(run, {}, "test");

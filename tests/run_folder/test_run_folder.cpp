@@ -149,7 +149,7 @@ std::filesystem::path writeRoundTripRun(const std::string& name) {
   frames[4].match = 1;
   frames[4].match_score = 2.5;
   writeFrames(dir, frames, FrameColumns::WithLoopClosures);
-  writePlaces(dir, {PlaceRecord{0, 0, 0, 2, 1, 40, 4}, PlaceRecord{1, 0, 3, 5, 4, 50, 5}});
+  writePlaces(dir, {PlaceRecord{0, 0, 0, 2, 1, 40, 4, "doorway"}, PlaceRecord{1, 0, 3, 5, 4, 50, 5, "stream_end"}});
   writeDroppedPlaces(dir, {});
   TopologyFile topology;
   topology.probability = 0.5;
@@ -212,6 +212,8 @@ SCENARIO("GIVEN a run folder made by the writers WHEN it is read back THEN every
   CHECK(run.places[1].keypoints == 50);
   CHECK(run.places[1].node == 5);
   CHECK(run.places[1].line == 3);
+  CHECK(run.places[0].end == "doorway");
+  CHECK(run.places[1].end == "stream_end");
   CHECK(run.dropped_places.empty());
   REQUIRE(run.topology.has_value());
   const TopologyFile& t = *run.topology;

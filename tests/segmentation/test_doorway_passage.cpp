@@ -20,6 +20,7 @@ using toposlam::DoorwayPassageDetector;
 using toposlam::FiedlerSegmenter;
 using toposlam::FiedlerSegmenterConfig;
 using toposlam::Fingerprint;
+using toposlam::PlaceEnd;
 using toposlam::SegmentedPlace;
 
 namespace {
@@ -208,6 +209,8 @@ TEST_CASE("GIVEN a border by appearance near a doorway passage WHEN segmented TH
     REQUIRE(places.size() == 2);
     CHECK(places[1].first_frame == 40);
     CHECK(segmenter->doorwayShifts() == 0);
+    CHECK(places[0].end == PlaceEnd::Valley);
+    CHECK(places[1].end == PlaceEnd::StreamEnd);
   }
   SECTION("the door 10 frames (2 s) after the appearance border: the place ends at the door") {
     const auto places = segmentWithDoor(7.0, 50, &segmenter);
@@ -215,6 +218,7 @@ TEST_CASE("GIVEN a border by appearance near a doorway passage WHEN segmented TH
     CHECK(places[1].first_frame == Approx(50).margin(1));
     CHECK(places[0].last_frame == places[1].first_frame - 1);
     CHECK(segmenter->doorwayShifts() == 1);
+    CHECK(places[0].end == PlaceEnd::ValleyAtDoorway);
     THEN("the representatives stay inside the borders found by appearance") {
       CHECK(places[0].representative_frame < 40);
       CHECK(places[1].representative_frame >= 40);
@@ -347,6 +351,8 @@ TEST_CASE("GIVEN a doorway passage and no border by appearance WHEN segmented TH
     CHECK(places[1].representative_frame >= places[1].first_frame);
     CHECK(segmenter->doorwayBorders() == 1);
     CHECK(segmenter->ignoredValleys() == 0);
+    CHECK(places[0].end == PlaceEnd::DoorwayPassage);
+    CHECK(std::string(toposlam::placeEndName(places[0].end)) == "doorway");
   }
   SECTION("segmenting by travel (window_m > 0): the passages only move borders, so no border") {
     CHECK(segmentBlocks(8.0, {}, {50}, &segmenter, 3.0).size() == 1);
@@ -436,6 +442,9 @@ TEST_CASE("GIVEN a valley still pending when the robot reaches a door WHEN segme
     CHECK(places[1].last_frame == places[2].first_frame - 1);
     CHECK(segmenter->interruptedValleys() == 1);
     CHECK(segmenter->doorwayBorders() == 1);
+    CHECK(places[0].end == PlaceEnd::InterruptedValley);
+    CHECK(places[1].end == PlaceEnd::DoorwayPassage);
+    CHECK(places[2].end == PlaceEnd::StreamEnd);
     THEN("each place's representative is from its own frames") {
       CHECK(places[0].representative_frame < 40);
       CHECK(places[1].representative_frame >= 40);

@@ -86,6 +86,9 @@ struct PlaceRecord {
   std::int64_t first = 0, last = 0, representative = 0;
   int keypoints = 0;
   int node = -1;
+  /// Why the place ended (placeEndName: valley, valley_at_doorway, doorway, interrupted_valley,
+  /// stream_end); empty when not known (a folder made from an LCM log, or written before the column).
+  std::string end;
 };
 
 /// topology.json: the most probable topology, and with `map` the filter's estimate at the end.
@@ -203,7 +206,7 @@ std::vector<PlaceRecord> placeRows(const std::vector<SegmentedPlace>& places,
 
 /// frames.csv. Names are quoted as CSV fields when they hold a comma, a quote or a line break.
 void writeFrames(const std::filesystem::path& dir, const std::vector<FrameRecord>& rows, FrameColumns columns);
-/// places.csv: `place,first,last,representative,keypoints,node`.
+/// places.csv: `place,first,last,representative,keypoints,node,end`.
 void writePlaces(const std::filesystem::path& dir, const std::vector<PlaceRecord>& rows);
 /// dropped_places.csv: the same columns.
 void writeDroppedPlaces(const std::filesystem::path& dir, const std::vector<PlaceRecord>& rows);

@@ -139,6 +139,17 @@ double maxFiedlerValue(int nodes);
 /// convention above. Throws std::invalid_argument for a non-square matrix; 0 for fewer than 2 nodes.
 double fiedlerValue(const Eigen::MatrixXd& affinity);
 
+/// Why a place ended (places.csv's `end` column; docs/segmentation.md lists the rules).
+enum class PlaceEnd : std::uint8_t {
+  Valley,             ///< a confirmed lambda2 valley, its border where appearance puts it
+  ValleyAtDoorway,    ///< a confirmed valley whose border moved to a doorway passage (rule 2)
+  DoorwayPassage,     ///< the frames reached a doorway passage (rule 1)
+  InterruptedValley,  ///< a pending valley closed at its border when a passage came (rule 4)
+  StreamEnd,          ///< the last frame (flush)
+};
+/// "valley", "valley_at_doorway", "doorway", "interrupted_valley", "stream_end".
+const char* placeEndName(PlaceEnd end);
+
 /// A closed place: frames [first_frame, last_frame] of the stream.
 struct SegmentedPlace {
   std::int64_t first_frame = 0;
@@ -157,6 +168,7 @@ struct SegmentedPlace {
   std::int64_t valley_frame = -1;
   /// Sequence number among kept places (dropped == false) or among dropped places, from 0.
   std::int64_t index = 0;
+  PlaceEnd end = PlaceEnd::Valley;
 };
 
 /// What one addFrame() produced.

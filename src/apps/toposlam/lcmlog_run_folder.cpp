@@ -83,7 +83,7 @@ void writeRunFolderFromLog(const LoggedRun& run, const std::string& log_path, co
   std::vector<PlaceRecord> places;
   for (const LoggedPlace& p : run.places)
     places.push_back(PlaceRecord{p.place, 0, p.first_frame, p.last_frame, p.representative_frame, p.keypoints,
-                                 node_of_place[p.place]});
+                                 node_of_place[p.place], ""});
   writePlaces(dir, places);
   TopologyFile topology;
   if (run.topology) {
