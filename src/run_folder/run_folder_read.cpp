@@ -206,6 +206,16 @@ std::vector<FrameRecord> loadFrames(const std::string& path) {
   return rows;
 }
 
+namespace {
+bool isPlaceEndName(const std::string& name) {
+  for (PlaceEnd e : {PlaceEnd::Valley, PlaceEnd::ValleyAtDoorway, PlaceEnd::DoorwayPassage,
+                     PlaceEnd::InterruptedValley, PlaceEnd::StreamEnd}) {
+    if (name == placeEndName(e)) return true;
+  }
+  return false;
+}
+}  // namespace
+
 std::vector<PlaceRecord> loadPlaces(const std::string& path) {
   const CsvTable t = readCsv(path);
   const int place = t.column("place"), first = t.column("first"), last = t.column("last"),
@@ -223,7 +233,14 @@ std::vector<PlaceRecord> loadPlaces(const std::string& path) {
     row.node = node >= 0 && !t.rows[r][static_cast<std::size_t>(node)].empty()
                    ? static_cast<int>(t.integer(r, node))
                    : -1;
-    if (end >= 0) row.end = t.rows[r][static_cast<std::size_t>(end)];
+    if (end >= 0) {
+      row.end = t.rows[r][static_cast<std::size_t>(end)];
+      if (!row.end.empty() && !isPlaceEndName(row.end)) {
+        throw RunFileError(where(t, r) + ": end '" + row.end +
+                           "' is not one of valley, valley_at_doorway, doorway, interrupted_valley, "
+                           "stream_end (or empty)");
+      }
+    }
     if (row.first < 0 || row.first > row.last || row.representative < row.first ||
         row.representative > row.last) {
       throw RunFileError(where(t, r) + ": need 0 <= first <= representative <= last, got " +

@@ -100,6 +100,16 @@ SCENARIO("GIVEN malformed run files WHEN loaded THEN the error names the file an
   writeText(dir / "places.csv", "place,first,last,representative\n0,5,3,4\n");
   CHECK_THROWS_WITH(loadPlaces((dir / "places.csv").string()),
                     Contains("places.csv:2: need 0 <= first <= representative <= last"));
+  writeText(dir / "places-end.csv",
+            "place,first,last,representative,keypoints,node,end\n0,0,3,1,50,0,valley\n1,4,6,5,50,1,vally\n");
+  CHECK_THROWS_WITH(loadPlaces((dir / "places-end.csv").string()),
+                    Contains("places-end.csv:3: end 'vally' is not one of valley, valley_at_doorway"));
+  writeText(dir / "places-end2.csv",
+            "place,first,last,representative,keypoints,node,end\n0,0,3,1,50,0,\n1,4,6,5,50,1,stream_end\n");
+  const auto ends = loadPlaces((dir / "places-end2.csv").string());
+  REQUIRE(ends.size() == 2);
+  CHECK(ends[0].end.empty());
+  CHECK(ends[1].end == "stream_end");
   writeText(dir / "topology.json", "{\"nodes\": []}");
   CHECK_THROWS_WITH(loadTopology((dir / "topology.json").string()),
                     Contains("topology.json: missing key 'probability'"));
