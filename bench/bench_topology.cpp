@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <span>
 #include <vector>
 
 #include <opencv2/core/utility.hpp>
@@ -28,6 +29,8 @@ struct TopologyBenchOptions {
   int particles = keyDefaultInt("topology.particles");
   int steps = 100;   ///< measured steps (a second traversal) per map size
   int budget = 250;  ///< work items per slice for the sliced measurement
+  /// Other frames per new place (segmentation.place_samples); > 0 steps with the relative likelihood.
+  int place_samples = keyDefaultInt("segmentation.place_samples");
   std::string samples;
   bool real = true;
   bool json = false;
@@ -61,7 +64,10 @@ class FakeSimilarity : public SimilarityMeasure {
 
 void runFilterBench(const TopologyBenchOptions& o, BenchRows& rows) {
   rows.text() << "TopologyParticleFilter, " << o.particles << " particles, fake similarity; a first traversal "
-            << "builds N places, then " << o.steps << " steps of a second traversal are measured\n";
+            << "builds N places, then " << o.steps << " steps of a second traversal are measured; "
+            << (o.place_samples > 0 ? "relative likelihood, " + std::to_string(o.place_samples) + " place samples"
+                                    : std::string("the representative alone"))
+            << "\n";
   rows.text() << std::setw(8) << "places" << std::setw(12) << "median ms" << std::setw(10) << "p99 ms"
             << std::setw(10) << "max ms" << std::setw(14) << "slice max ms" << std::setw(10) << "states"
             << std::setw(10) << "records" << std::setw(8) << "best p"
@@ -71,18 +77,24 @@ void runFilterBench(const TopologyBenchOptions& o, BenchRows& rows) {
     TopologyFilterConfig config;
     config.particles = o.particles;
     config.seed = 1;
+    if (o.place_samples > 0) config.likelihood = LikelihoodModel::Relative;
     TopologyParticleFilter filter(config, similarity);
-    for (int p = 0; p < places; ++p) filter.step(tagged(p));
+    std::vector<std::shared_ptr<const Fingerprint>> place_samples;
+    auto samplesOf = [&](int tag) {
+      place_samples.assign(static_cast<std::size_t>(o.place_samples), tagged(tag));
+      return std::span<const std::shared_ptr<const Fingerprint>>(place_samples);
+    };
+    for (int p = 0; p < places; ++p) filter.step(tagged(p), {}, samplesOf(p));
     std::vector<double> step_ms, slice_ms;
     for (int k = 0; k < o.steps; ++k) {
       auto fingerprint = tagged(k % places);
       if (k % 2 == 0) {
         Stopwatch watch;
-        filter.step(fingerprint);
+        filter.step(fingerprint, {}, samplesOf(k % places));
         step_ms.push_back(watch.elapsedMs());
       } else {
         // Sliced: the pipeline's way of spreading a step over frames.
-        filter.beginStep(fingerprint);
+        filter.beginStep(fingerprint, {}, samplesOf(k % places));
         bool done = false;
         while (!done) {
           Stopwatch watch;
@@ -160,6 +172,10 @@ void addBenchTopology(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--budget", options->budget, "Work items per slice (sliced steps)")
       ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
+  cmd->add_option("--place-samples", options->place_samples,
+                  "Other frames per new place in the filter part (0 = the representative alone)")
+      ->check(keyRange("segmentation.place_samples"))
       ->capture_default_str();
   cmd->add_option("--samples", options->samples, "Frames for the real-similarity part")
       ->capture_default_str();

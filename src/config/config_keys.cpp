@@ -432,7 +432,12 @@ std::vector<ConfigKey> makeKeys() {
                      "a place's representative: the window frame of largest degree (thesis), or the sampled "
                      "frame most like the place's others"));
   k.push_back(real("segmentation.representative_interval_s", AT(segmentation.representative_interval_s), 0.5, 0, 3600,
-                   "seconds", "place-medoid: the place's frames are sampled at most this often (0 = every frame)"));
+                   "seconds", "place-medoid and place_samples: the place's frames are sampled at most this often "
+                   "(0 = every frame)"));
+  k.push_back(integer("segmentation.place_samples", AT(segmentation.place_samples), 3, 0,
+                      FiedlerSegmenterConfig::kMaxQuerySamples, "",
+                      "other frames of a closed place that the relative likelihood compares with the stored places "
+                      "besides its representative (0 = the representative alone, the thesis)"));
   // Topology (TopologyFilterConfig, the stage's slicing beside it).
   k.push_back(integer("topology.particles", AT(topology.particles), 500, 1, 1000000, "",
                       "particles over topologies (thesis: 500)"));

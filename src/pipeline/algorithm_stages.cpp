@@ -142,6 +142,7 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
     place.representative_frame = p.representative_frame;
     place.keypoints = p.representative_keypoints;
     place.representative = p.representative;
+    place.samples.assign(p.samples.begin(), p.samples.begin() + p.sample_count);
     if (evidence_) place.evidence = evidence_->closePlace(p.first_frame, p.last_frame);
     const auto it = std::find_if(thumbnails_.begin(), thumbnails_.end(),
                                  [&](const auto& entry) { return entry.first == p.representative_frame; });
@@ -151,6 +152,8 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
   // Frames up to the closed place's end are no longer needed.
   std::erase_if(thumbnails_, [&](const auto& entry) { return entry.first <= p.last_frame; });
   p.representative.reset();  // the topology stage holds it as long as it needs it
+  p.samples = {};
+  p.sample_count = 0;
   last_closed_ = std::move(p);
   return out;
 }
@@ -198,7 +201,7 @@ std::optional<FinishedPlace> ParticleFilterTopologyStage::advance(double budget_
       const std::vector<double>& by_place = queue_.front().evidence;
       step_evidence_.assign(by_place.empty() ? 0 : static_cast<std::size_t>(run_first_observation_), 0.0);
       step_evidence_.insert(step_evidence_.end(), by_place.begin(), by_place.end());
-      filter_->beginStep(queue_.front().representative, step_evidence_);
+      filter_->beginStep(queue_.front().representative, step_evidence_, queue_.front().samples);
     }
     if (filter_->advance(slice_items_)) {
       FinishedPlace done{std::move(queue_.front()), PlaceAssignment{}};

@@ -21,6 +21,8 @@ std::string DoorwayPassageConfig::validate() const {
     problem << "max_growth: " << max_growth << " is outside the allowed range [1, 10]";
   } else if (!(step_fraction >= 0.0 && step_fraction <= 1.0)) {
     problem << "step_fraction: " << step_fraction << " is outside the allowed range [0, 1]";
+  } else if (!(min_outward_speed_fraction >= 0.0 && min_outward_speed_fraction <= 1.0)) {
+    problem << "min_outward_speed_fraction: " << min_outward_speed_fraction << " is outside the allowed range [0, 1]";
   } else if (!(max_lookahead_s > 0.0 && max_lookahead_s <= 60.0)) {
     problem << "max_lookahead_s: " << max_lookahead_s << " is outside the allowed range (0, 60]";
   } else if (!(pair_tolerance_s >= 0.0 && pair_tolerance_s <= 10.0)) {
@@ -79,12 +81,34 @@ void DoorwayPassageDetector::addFrame(double time_s, int image_width, const std:
   next_tracks_.clear();
   for (const Track& track : tracks_) {
     const double last = track.lastOffset();
+    // An edge that has been moving out keeps moving out: a continuation must move out by at least
+    // min_outward_speed_fraction of the track's mean outward speed over its last fit_s seconds, less
+    // the inward jitter. A stalled edge where a fast one was expected is another edge (the jamb left
+    // the view and a far edge at the border took its place).
+    double min_growth = -0.25 * step;
+    if (config_.min_outward_speed_fraction > 0.0 && track.count >= 2) {
+      const int kept = std::min(track.count, kFitPoints);
+      int n = 1;
+      while (n < kept && track.time[static_cast<std::size_t>((track.count - 1 - n) % kFitPoints)] >=
+                             track.lastTime() - config_.fit_s - 1e-9) {
+        ++n;
+      }
+      if (n >= 2) {
+        const auto first = static_cast<std::size_t>((track.count - n) % kFitPoints);
+        const double span_s = track.lastTime() - track.time[first];
+        const double speed = span_s > 0.0 ? (last - track.offset[first]) / span_s : 0.0;
+        if (speed > 0.0) {
+          min_growth = std::max(min_growth, config_.min_outward_speed_fraction * speed *
+                                                    (time_s - track.lastTime()) - 0.25 * step);
+        }
+      }
+    }
     std::size_t best = edges;
     double best_growth = 0.0;
     for (std::size_t j = 0; j < edges; ++j) {
       if (edge_used_[j] != 0 || sideOf(j) != track.side) continue;
       const double growth = offsetOf(j) - last;
-      if (growth < -0.25 * step || offsetOf(j) > last * config_.max_growth + step) continue;
+      if (growth < min_growth || offsetOf(j) > last * config_.max_growth + step) continue;
       if (best == edges || growth < best_growth) {
         best = j;
         best_growth = growth;

@@ -105,6 +105,9 @@ std::string FiedlerSegmenterConfig::validate() const {
   if (auto p = outside("window_m", window_m, 0, 1000, " m", " (0 = off)")) return *p;
   if (auto p = outside("min_frame_spacing_m", min_frame_spacing_m, 0, 100, " m", " (0 = off)")) return *p;
   if (auto p = outside("representative_interval_s", representative_interval_s, 0, 3600, " s", " (0 = every frame)")) return *p;
+  if (place_samples < 0 || place_samples > kMaxQuerySamples)
+    return "place_samples: " + std::to_string(place_samples) + " is outside the allowed range [0, " +
+           std::to_string(kMaxQuerySamples) + "]";
   if (auto p = outside("min_frame_spacing_rad", min_frame_spacing_rad, 0, 10, " rad", "")) return *p;
   if (auto p = outside("doorway_shift_s", doorway_shift_s, 0, 60, " s", " (0 = off)")) return *p;
   if (min_window_frames < 3 || min_window_frames > window) {
@@ -177,6 +180,48 @@ FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const S
                                                    FiedlerSegmenterConfig::kMaxPlaceSamples);
     sample_interval_s_ = config_.representative_interval_s;
   }
+  if (config_.place_samples > 0) {
+    query_samples_.reserve(FiedlerSegmenterConfig::kMaxPlaceSamples);
+    query_sample_interval_s_ = config_.representative_interval_s;
+  }
+}
+
+void FiedlerSegmenter::sampleQueryFrame(int slot) {
+  const auto s = static_cast<std::size_t>(slot);
+  if (slot_fingerprint_[s]->keypointCount() < config_.min_keypoints) return;
+  const double since_s = slot_time_[s] - last_query_sample_s_;
+  // A clock that goes back (a new traversal) always samples.
+  if (since_s >= 0.0 && since_s < query_sample_interval_s_ - 1e-9) return;
+  if (query_samples_.size() == static_cast<std::size_t>(FiedlerSegmenterConfig::kMaxPlaceSamples)) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < query_samples_.size(); i += 2) query_samples_[kept++] = std::move(query_samples_[i]);
+    query_samples_.resize(kept);
+    query_sample_interval_s_ *= 2.0;
+  }
+  query_samples_.push_back(Candidate{slot_frame_[s], 0.0, slot_time_[s], slot_fingerprint_[s],
+                                     slot_fingerprint_[s]->keypointCount()});
+  last_query_sample_s_ = slot_time_[s];
+}
+
+void FiedlerSegmenter::takeQuerySamples(SegmentedPlace& place, std::int64_t last_frame) {
+  std::size_t in_place = 0, first = 0;
+  while (in_place < query_samples_.size() && query_samples_[in_place].frame <= last_frame) ++in_place;
+  while (first < in_place && query_samples_[first].frame < place.first_frame) ++first;
+  std::size_t others = 0;
+  for (std::size_t i = first; i < in_place; ++i) others += query_samples_[i].frame != place.representative_frame;
+  const std::size_t take = std::min(others, static_cast<std::size_t>(config_.place_samples));
+  // The k-th of `take` is the ((2k + 1) * others / (2 take))-th other sample: the middles of equal parts.
+  std::size_t seen = 0, k = 0;
+  for (std::size_t i = first; i < in_place && k < take; ++i) {
+    if (query_samples_[i].frame == place.representative_frame) continue;
+    if (seen == (2 * k + 1) * others / (2 * take)) {
+      place.samples[k++] = query_samples_[i].fingerprint;
+    }
+    ++seen;
+  }
+  place.sample_count = static_cast<int>(k);
+  query_samples_.erase(query_samples_.begin(), query_samples_.begin() + static_cast<std::ptrdiff_t>(in_place));
+  query_sample_interval_s_ = config_.representative_interval_s;
 }
 
 void FiedlerSegmenter::samplePlaceFrame(int slot) {
@@ -492,6 +537,7 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
   }
   rememberBestWindowFrame(place_start_, std::numeric_limits<std::int64_t>::max());
   if (config_.representative == RepresentativeChoice::PlaceMedoid) samplePlaceFrame(slot);
+  if (config_.place_samples > 0) sampleQueryFrame(slot);
 
   // The detector sees lambda2 only once the window is full: while it fills, lambda2 of a perfectly
   // connected window falls as k/(k-1) (2, 1.5, 1.33, ...), which would read as a peak.
@@ -706,6 +752,7 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
     place.representative = best->fingerprint;
     place.representative_keypoints = best->keypoints;
   }
+  if (config_.place_samples > 0) takeQuerySamples(place, last_frame);
   place.dropped = place.representative_keypoints < config_.min_keypoints;
   place.index = place.dropped ? dropped_places_++ : kept_places_++;
 

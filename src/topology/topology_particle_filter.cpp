@@ -252,7 +252,8 @@ void TopologyParticleFilter::relativeLikelihoods() {
 }
 
 void TopologyParticleFilter::beginStep(std::shared_ptr<const Fingerprint> representative,
-                                       std::span<const double> evidence) {
+                                       std::span<const double> evidence,
+                                       std::span<const std::shared_ptr<const Fingerprint>> samples) {
   if (phase_ != Phase::Idle) throw std::logic_error("TopologyParticleFilter: a step is already in progress");
   if (!representative) throw std::invalid_argument("TopologyParticleFilter: null representative");
   if (evidence.size() > idx(observation_count_))
@@ -263,6 +264,11 @@ void TopologyParticleFilter::beginStep(std::shared_ptr<const Fingerprint> repres
   if (observation_count_ == std::numeric_limits<std::int32_t>::max())
     throw std::length_error("too many observations");
   pending_ = std::move(representative);
+  pending_samples_.clear();
+  if (config_.likelihood == LikelihoodModel::Relative)
+    for (const auto& sample : samples)
+      if (sample) pending_samples_.push_back(sample);
+  sample_similarity_.assign(pending_samples_.size() * idx(observation_count_), 0.0);
   ++stamp_;
   const std::size_t m = particles_.size();
   groups_.clear();
@@ -310,21 +316,37 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
         phase_ = Phase::Propose;
         cursor_ = 0;
         break;
-      case Phase::Similarity:
-        for (; cursor_ < compared_list_.size(); ++cursor_) {
+      case Phase::Similarity: {
+        // The representative's comparisons, then each sample's: one work item each.
+        const std::size_t compared = compared_list_.size();
+        for (; cursor_ < compared * (1 + pending_samples_.size()); ++cursor_) {
           if (used++ >= budget) return false;
-          const auto o = idx(compared_list_[cursor_]);
-          const double s = similarity_.similarity(*fingerprints_[o], *pending_);
-          similarity_of_[o] = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
+          const std::size_t pass = cursor_ / compared;
+          const auto o = idx(compared_list_[cursor_ % compared]);
+          const Fingerprint& query = pass == 0 ? *pending_ : *pending_samples_[pass - 1];
+          const double s = similarity_.similarity(*fingerprints_[o], query);
+          const double value = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
+          if (pass == 0) {
+            similarity_of_[o] = value;
+          } else {
+            sample_similarity_[(pass - 1) * similarity_of_.size() + o] = value;
+          }
         }
         if (indexed_step_) fillBackground();
-        if (config_.likelihood == LikelihoodModel::Relative) relativeLikelihoods();
+        if (config_.likelihood == LikelihoodModel::Relative) {
+          if (pending_samples_.empty()) {
+            relativeLikelihoods();
+          } else {
+            relativeLikelihoodsWithSamples();
+          }
+        }
         if (!evidence_.empty())
           for (const std::int32_t o : needed_list_)
             if (idx(o) < evidence_.size()) similarity_of_[idx(o)] = std::max(similarity_of_[idx(o)], evidence_[idx(o)]);
         phase_ = Phase::Aggregate;
         cursor_ = 0;
         break;
+      }
       case Phase::Aggregate:
         for (; cursor_ < groups_.size(); ++cursor_) {
           if (used++ >= budget) return false;
@@ -439,6 +461,30 @@ bool TopologyParticleFilter::advance(std::size_t budget) {
   return true;
 }
 
+void TopologyParticleFilter::relativeLikelihoodsWithSamples() {
+  // Each sample's similarities become relative likelihoods exactly as the representative's do (an
+  // indexed step fills the uncompared ones with that sample's own background); a stored
+  // representative keeps the best of them. Its likelihood is then sqrt(l_rep * max(l_rep, l_best)):
+  // a sample can raise it, never lower it, and a single sample matching alone cannot reach 1.
+  const std::size_t n = similarity_of_.size();
+  representative_similarity_ = similarity_of_;
+  best_sample_likelihood_.assign(n, 0.0);
+  for (std::size_t k = 0; k < pending_samples_.size(); ++k) {
+    for (const std::int32_t o : compared_list_) similarity_of_[idx(o)] = sample_similarity_[k * n + idx(o)];
+    if (indexed_step_) fillBackground();
+    relativeLikelihoods();
+    for (const std::int32_t o : needed_list_)
+      best_sample_likelihood_[idx(o)] = std::max(best_sample_likelihood_[idx(o)], similarity_of_[idx(o)]);
+  }
+  similarity_of_ = representative_similarity_;
+  if (indexed_step_) fillBackground();
+  relativeLikelihoods();
+  for (const std::int32_t o : needed_list_) {
+    double& l = similarity_of_[idx(o)];
+    l = std::sqrt(l * std::max(l, best_sample_likelihood_[idx(o)]));
+  }
+}
+
 void TopologyParticleFilter::selectComparisons() {
   // needed_ marks: 1 = stored, 2 = compared (candidate or not indexable), 3 = compared (background sample).
   indexed_step_ = false;
@@ -548,13 +594,15 @@ void TopologyParticleFilter::finishStep() {
   groups_.clear();
   fingerprints_.push_back(std::move(pending_));
   pending_.reset();
+  pending_samples_.clear();
   ++observation_count_;
   phase_ = Phase::Idle;
   cursor_ = 0;
 }
 
-void TopologyParticleFilter::step(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence) {
-  beginStep(std::move(representative), evidence);
+void TopologyParticleFilter::step(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence,
+                                  std::span<const std::shared_ptr<const Fingerprint>> samples) {
+  beginStep(std::move(representative), evidence, samples);
   while (!advance(std::numeric_limits<std::size_t>::max())) {
   }
 }

@@ -41,6 +41,10 @@ TEST_CASE("GIVEN a full window WHEN frames keep arriving and places close THEN a
     config.representative = toposlam::RepresentativeChoice::PlaceMedoid;
     config.representative_interval_s = 0.0;
   }
+  SECTION("three place samples, every frame sampled") {
+    config.place_samples = 3;
+    config.representative_interval_s = 0.0;
+  }
   toposlam::FiedlerSegmenter segmenter(config, similarity);
   std::vector<std::shared_ptr<const toposlam::Fingerprint>> prints;
   for (int f = 0; f < 400; ++f) prints.push_back(toposlam::test::fakeFingerprint(f));

@@ -546,3 +546,50 @@ TEST_CASE("GIVEN representative settings WHEN validated or parsed THEN bad ones 
   CHECK(std::string(toString(RepresentativeChoice::WindowDegree)) == "window-degree");
   CHECK_THROWS_WITH(parseRepresentativeChoice("middle"), Catch::Contains("window-degree or place-medoid"));
 }
+
+TEST_CASE(
+    "GIVEN place samples WHEN a place closes THEN it carries that many other keypoint-rich frames of it, spread "
+    "over the place",
+    "[segmentation][segmenter][samples]") {
+  const std::vector<int> labels = blockLabels({30, 30, 30});
+  TableSimilarity similarity([&](int a, int b) {
+    return labels[static_cast<std::size_t>(a)] == labels[static_cast<std::size_t>(b)] ? 0.9 : 0.05;
+  });
+  FiedlerSegmenterConfig config = thesisConfig();
+  config.place_samples = 3;  // at most one per 0.5 s: every third frame at 5 fps
+  FiedlerSegmenter segmenter(config, similarity);
+  // Odd frames have 5 keypoints (below min_keypoints): never a sample.
+  const Run run = runStream(segmenter, 90, [](int f) { return f % 2 == 0 ? 50 : 5; });
+  REQUIRE(run.places.size() == 3);
+  for (const SegmentedPlace& place : run.places) {
+    INFO("place " << place.first_frame << ".." << place.last_frame);
+    REQUIRE(place.sample_count == 3);
+    std::vector<int> ids;
+    for (int k = 0; k < place.sample_count; ++k) ids.push_back(place.samples[static_cast<std::size_t>(k)]->image_width);
+    CHECK(std::is_sorted(ids.begin(), ids.end()));
+    for (int id : ids) {
+      CHECK(id >= place.first_frame);
+      CHECK(id <= place.last_frame);
+      CHECK(id != place.representative_frame);
+      CHECK(id % 2 == 0);
+    }
+    // Spread: one in each third of the place.
+    const double third = (place.last_frame - place.first_frame + 1) / 3.0;
+    CHECK(ids[0] < place.first_frame + third);
+    CHECK(ids[2] >= place.first_frame + 2 * third);
+    for (int k = 3; k < FiedlerSegmenterConfig::kMaxQuerySamples; ++k) CHECK(place.samples[static_cast<std::size_t>(k)] == nullptr);
+  }
+  AND_WHEN("place samples are off (the thesis)") {
+    FiedlerSegmenter thesis(thesisConfig(), similarity);
+    const Run off = runStream(thesis, 90);
+    THEN("the places are the same and carry none") {
+      REQUIRE(off.places.size() == 3);
+      for (std::size_t i = 0; i < 3; ++i) {
+        CHECK(off.places[i].sample_count == 0);
+        CHECK(off.places[i].last_frame == run.places[i].last_frame);
+      }
+    }
+  }
+  config.place_samples = FiedlerSegmenterConfig::kMaxQuerySamples + 1;
+  CHECK_THROWS_WITH(FiedlerSegmenter(config, similarity), Catch::Contains("place_samples: 17 is outside the allowed range [0, 16]"));
+}

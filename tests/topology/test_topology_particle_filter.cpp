@@ -542,3 +542,95 @@ TEST_CASE("GIVEN a new node's likelihood floor below 0, at 1 or not a number WHE
   config.new_node_likelihood_floor = 0.0;
   CHECK(config.validate().empty());
 }
+
+namespace {
+/// Lap 1 stores places 0..7; lap 2's representatives are tags 100 + p, which score `representative` with
+/// place p, and its samples tags 200 + p, which score 0.3 with it (a view of the same spot). Every other
+/// pair scores 0.01-0.06, as different real places do.
+test::TagSimilarity samplesSimilarity(double representative) {
+  return test::TagSimilarity([representative](int a, int b) {
+    const int lo = std::min(a, b), hi = std::max(a, b);
+    if (a == b) return 1.0;
+    if (lo < 100 && hi == lo + 100) return representative;
+    if (lo < 100 && hi == lo + 200) return 0.3;
+    return 0.01 + 0.01 * ((a * 7 + b * 3) % 6);
+  });
+}
+
+/// The default preset's filter (src/config/method_preset.cpp), with the given seed.
+TopologyFilterConfig defaultPresetConfig(std::uint64_t seed) {
+  TopologyFilterConfig config = relativeConfig(4.25, false);
+  config.seed = seed;
+  config.gamma_shape = 5.0;
+  config.gamma_scale = 0.4;
+  config.new_node_probability = 0.02;
+  config.new_node_likelihood_floor = 0.01;
+  return config;
+}
+
+std::vector<int> runTwoLaps(TopologyParticleFilter& filter, int samples_per_place) {
+  for (int p = 0; p < 8; ++p) filter.step(taggedFingerprint(p));
+  for (int p = 0; p < 8; ++p) {
+    const std::vector<std::shared_ptr<const Fingerprint>> samples(static_cast<std::size_t>(samples_per_place),
+                                                                  taggedFingerprint(200 + p));
+    filter.step(taggedFingerprint(100 + p), {}, samples);
+  }
+  return filter.estimate(0).best.assignment;
+}
+}  // namespace
+
+TEST_CASE("GIVEN a revisit whose representative barely matches WHEN its place samples match THEN the relative "
+          "likelihood closes the loop, and without samples it does not",
+          "[topology][relative][samples]") {
+  // The representative alone: z = (0.12 - 0.035) / 0.02 = 4.25, a likelihood of 0.5, too weak against a new
+  // node's 1 - 0.5 at the prior of a revisit. A sample at 0.3 stands out by z = 13: sqrt(0.5 x 1) = 0.71.
+  const auto sim = samplesSimilarity(0.12);
+  const std::vector<int> closed = route(8, 2);
+  for (std::uint64_t seed : {1u, 3u, 7u}) {
+    INFO("seed " << seed);
+    TopologyParticleFilter alone(defaultPresetConfig(seed), sim), with_samples(defaultPresetConfig(seed), sim);
+    const std::vector<int> without = runTwoLaps(alone, 0);
+    CHECK(*std::max_element(without.begin(), without.end()) == 15);  // every place a new node
+    CHECK(runTwoLaps(with_samples, 3) == closed);
+    CHECK(with_samples.estimate(0).best.probability > 0.35);
+  }
+  // Samples cannot close a place alone: with a representative that does not stand out at all (0.03),
+  // matching samples leave every second-lap place a new node.
+  const auto unrelated = samplesSimilarity(0.03);
+  TopologyParticleFilter filter(defaultPresetConfig(1), unrelated);
+  const std::vector<int> assignment = runTwoLaps(filter, 3);
+  CHECK(*std::max_element(assignment.begin(), assignment.end()) == 15);
+}
+
+TEST_CASE("GIVEN place samples WHEN a step runs in slices THEN it is identical to a whole step, and the absolute "
+          "likelihood ignores them",
+          "[topology][samples][slice]") {
+  const auto sim = samplesSimilarity(0.12);
+  TopologyParticleFilter whole(defaultPresetConfig(1), sim), sliced(defaultPresetConfig(1), sim);
+  for (int p = 0; p < 8; ++p) {
+    whole.step(taggedFingerprint(p));
+    sliced.step(taggedFingerprint(p));
+  }
+  int slices = 0;
+  for (int p = 0; p < 8; ++p) {
+    const std::vector<std::shared_ptr<const Fingerprint>> samples{taggedFingerprint(200 + p), nullptr,
+                                                                  taggedFingerprint(300 + p)};
+    whole.step(taggedFingerprint(100 + p), {}, samples);
+    sliced.beginStep(taggedFingerprint(100 + p), {}, samples);
+    while (!sliced.advance(5)) ++slices;
+    REQUIRE(stateBytes(whole) == stateBytes(sliced));
+  }
+  CHECK(slices > 8 * 3);  // (1 + 2 samples) x 8 stored comparisons alone are 24 items a step
+
+  TopologyParticleFilter absolute_with(configWith(200, 3), sim), absolute_without(configWith(200, 3), sim);
+  for (int p = 0; p < 8; ++p) {
+    absolute_with.step(taggedFingerprint(p));
+    absolute_without.step(taggedFingerprint(p));
+  }
+  for (int p = 0; p < 8; ++p) {
+    const std::vector<std::shared_ptr<const Fingerprint>> samples{taggedFingerprint(200 + p)};
+    absolute_with.step(taggedFingerprint(100 + p), {}, samples);
+    absolute_without.step(taggedFingerprint(100 + p));
+  }
+  CHECK(stateBytes(absolute_with) == stateBytes(absolute_without));
+}

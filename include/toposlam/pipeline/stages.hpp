@@ -30,6 +30,8 @@ struct ClosedPlace {
   std::int64_t representative_frame = 0;
   int keypoints = 0;                      ///< keypoints of the representative
   std::shared_ptr<const Fingerprint> representative;
+  /// Other frames of the place (SegmentedPlace::samples) for the relative likelihood; may be empty.
+  std::vector<std::shared_ptr<const Fingerprint>> samples;
   cv::Mat thumbnail;                      ///< small BGR image of the representative (may be empty)
   /// Sequence evidence (PlaceSequenceEvidence), one likelihood per earlier place of this run in closing
   /// order; empty when the segmentation stage has none.

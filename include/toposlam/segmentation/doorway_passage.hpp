@@ -41,6 +41,12 @@ struct DoorwayPassageConfig {
   /// `step_fraction` of the half-width (it may move in by `step_fraction / 4` of the half-width: jitter).
   double max_growth = 1.6;
   double step_fraction = 0.06;
+  /// A track whose edge moves out is continued only by an edge that moves out by at least this fraction
+  /// of the track's mean outward speed over its last `fit_s` (less the inward jitter). When the jamb
+  /// leaves the view, a far edge standing near the border would otherwise continue its track, and its
+  /// slow drift predicts the passage seconds late (docs/segmentation.md, "Jamb tracks taken over by a
+  /// far edge"). 0 turns the check off.
+  double min_outward_speed_fraction = 0.4;
   /// A passage predicted further ahead than this (seconds after the track's last frame) is ignored: an
   /// edge far away that merely drifts out.
   double max_lookahead_s = 3.0;

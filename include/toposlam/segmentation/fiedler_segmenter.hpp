@@ -40,6 +40,7 @@
 // (test_segmentation_alloc counts malloc calls); the similarity measure's own allocations aside.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -126,8 +127,15 @@ struct FiedlerSegmenterConfig {
   RepresentativeChoice representative = RepresentativeChoice::WindowDegree;
   /// PlaceMedoid: the place's frames are sampled at most this often (its first frame always; allowed
   /// [0, 3600] s, 0 = every frame); at most kMaxPlaceSamples are kept, halving the rate when full.
+  /// The same interval spaces the place samples below.
   double representative_interval_s = 0.5;
   static constexpr int kMaxPlaceSamples = 64;
+  /// Besides its representative, a closed place carries up to this many of its frames (with at least
+  /// min_keypoints keypoints, one per representative_interval_s at most, spread evenly over the place),
+  /// which the relative likelihood compares with the stored representatives too (docs/topology.md,
+  /// "Place samples"). Allowed [0, kMaxQuerySamples]; 0 = the representative alone (the thesis).
+  int place_samples = 0;
+  static constexpr int kMaxQuerySamples = 16;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
   std::string validate() const;
 };
@@ -162,6 +170,10 @@ struct SegmentedPlace {
   double representative_degree = 0.0;
   std::shared_ptr<const Fingerprint> representative;
   int representative_keypoints = 0;
+  /// The first sample_count are up to place_samples other frames of the place, in frame order (see
+  /// FiedlerSegmenterConfig); a fixed array, so closing a place allocates nothing.
+  std::array<std::shared_ptr<const Fingerprint>, FiedlerSegmenterConfig::kMaxQuerySamples> samples{};
+  int sample_count = 0;
   bool dropped = false;            ///< representative had fewer than min_keypoints keypoints
   /// Frame of the lambda2 valley that closed it, or (doorway_borders) the border frame of the doorway
   /// passage that did; -1 when flushed (the end of the stream).
@@ -262,6 +274,13 @@ class FiedlerSegmenter {
   std::optional<std::pair<int, double>> placeMedoid(int count) const;
   /// PlaceMedoid: forgets the first `count` samples (a closed place's).
   void dropPlaceSamples(int count);
+  /// place_samples > 0: keeps the frame just added (slot) as a place sample when it has min_keypoints
+  /// keypoints and the sampling interval allows.
+  void sampleQueryFrame(int slot);
+  /// place_samples > 0: moves up to place_samples of the samples in [place.first_frame, last_frame]
+  /// (not the representative), spread evenly, into place.samples, and forgets the samples up to
+  /// last_frame.
+  void takeQuerySamples(SegmentedPlace& place, std::int64_t last_frame);
   /// doorway_shift_s: moves the pending border to the doorway passage nearest to it, when there is one
   /// and the border stays inside (place start, newest frame] with a representative candidate before it.
   /// False when the border is to be dropped (doorway_borders: its nearest passage is the one the open
@@ -332,6 +351,11 @@ class FiedlerSegmenter {
   Eigen::MatrixXd place_sample_affinity_;
   double sample_interval_s_ = 0.0;     ///< the current sampling interval (doubles when thinned)
   std::int64_t sample_stride_ = 1;     ///< ... and in frames (doubles when thinned)
+  // place_samples > 0: the open place's samples (and those after a pending border), in frame order,
+  // at most kMaxPlaceSamples (every other one dropped and the interval doubled when full).
+  std::vector<Candidate> query_samples_;
+  double query_sample_interval_s_ = 0.0;
+  double last_query_sample_s_ = -std::numeric_limits<double>::infinity();
   std::int64_t kept_places_ = 0;
   std::int64_t dropped_places_ = 0;
   std::int64_t ignored_valleys_ = 0;

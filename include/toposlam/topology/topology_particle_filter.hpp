@@ -217,14 +217,21 @@ class TopologyParticleFilter {
   /// `evidence` (optional): per earlier observation, a likelihood in [0, 1] from outside the
   /// representatives (PlaceSequenceEvidence); a stored representative's likelihood is then the larger of
   /// its own and its observation's evidence. Empty: the representatives alone (the thesis).
-  void beginStep(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence = {});
+  /// `samples` (optional, LikelihoodModel::Relative only): other frames of the same place. Each is
+  /// compared with the stored representatives like the representative and turned into relative
+  /// likelihoods the same way; a stored representative's likelihood is then the geometric mean of the
+  /// representative's and the larger of it and the best sample's (docs/topology.md, "Place samples").
+  /// Null samples are ignored.
+  void beginStep(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence = {},
+                 std::span<const std::shared_ptr<const Fingerprint>> samples = {});
   /// Runs at most `budget` work items of the current step (>= 1; one item = one similarity evaluation,
   /// one distinct topology scanned or aggregated, or one particle proposed/weighted/updated). Returns
   /// true when the step is complete (also when no step is in progress). Sliced and whole runs of a step
   /// give identical results.
   bool advance(std::size_t budget);
   /// beginStep + advance until done.
-  void step(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence = {});
+  void step(std::shared_ptr<const Fingerprint> representative, std::span<const double> evidence = {},
+            std::span<const std::shared_ptr<const Fingerprint>> samples = {});
   bool stepInProgress() const { return phase_ != Phase::Idle; }
 
   const TopologyFilterConfig& config() const { return config_; }
@@ -279,6 +286,8 @@ class TopologyParticleFilter {
   void selectComparisons();
   /// After the exact comparisons of an indexed step: the background for the others.
   void fillBackground();
+  /// Relative likelihoods with the place's samples (see beginStep), in place in similarity_of_.
+  void relativeLikelihoodsWithSamples();
 
   TopologyFilterConfig config_;
   const SimilarityMeasure& similarity_;
@@ -296,6 +305,12 @@ class TopologyParticleFilter {
   Phase phase_ = Phase::Idle;
   std::size_t cursor_ = 0;
   std::shared_ptr<const Fingerprint> pending_;
+  std::vector<std::shared_ptr<const Fingerprint>> pending_samples_;  ///< the place's other frames
+  /// Raw similarities of the samples, sample-major: [k * observations + o]; then the best relative
+  /// likelihood per observation.
+  std::vector<double> sample_similarity_;
+  std::vector<double> best_sample_likelihood_;
+  std::vector<double> representative_similarity_;
   std::vector<StatePtr> groups_;        ///< distinct parent states, in order of first particle
   std::vector<std::int32_t> group_of_;  ///< per particle
   std::vector<unsigned char> needed_;   ///< per observation: referenced by some group

@@ -384,6 +384,10 @@ void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const Method
                           {"segmentation.delta", real(s.valley.delta)},
                           {"segmentation.cut", toString(s.cut_placement)},
                           {"segmentation.representative", representative},
+                          {"segmentation.place_samples",
+                           s.place_samples > 0 ? std::to_string(s.place_samples) + ", at most one per " +
+                                                     real(s.representative_interval_s) + " s"
+                                               : std::string("0 (the representative alone)")},
                           {"topology.particles", std::to_string(topo.particles)},
                           {"topology.likelihood", toString(topo.likelihood)},
                           {"topology.seed", std::to_string(topo.seed)},

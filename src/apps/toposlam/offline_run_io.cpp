@@ -31,7 +31,7 @@ void writeImageFile(const std::filesystem::path& path, const cv::Mat& image) {
 }
 
 namespace {
-enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kDoorwayShift, kDoorwayBorders, kRepresentative, kRepresentativeInterval };
+enum SegmentationKey { kWindowS, kWindow, kMinWindowFrames, kGamma, kDelta, kFloor, kMinKeypoints, kCut, kDoorwayShift, kDoorwayBorders, kRepresentative, kRepresentativeInterval, kPlaceSamples };
 }  // namespace
 
 void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
@@ -103,6 +103,12 @@ void addSegmentationOptions(CLI::App& command, SegmentationOptions& options) {
                          ->capture_default_str()
                          ->check(keyRange("segmentation.representative_interval_s")),
                      kRepresentativeInterval);
+  given.emplace_back(command.add_option("--place-samples", c.place_samples,
+                                        "Segmentation: other frames of a place compared with the stored places "
+                                        "besides its representative (0 = the representative alone, the thesis)")
+                         ->capture_default_str()
+                         ->check(keyRange("segmentation.place_samples")),
+                     kPlaceSamples);
 }
 
 MethodPreset presetOf(const SegmentationOptions& options, const std::string& command) {
@@ -131,6 +137,7 @@ FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const
       case kDoorwayBorders: config.doorway_borders = o.doorway_borders; break;
       case kRepresentative: config.representative = parseRepresentativeChoice(options.representative); break;
       case kRepresentativeInterval: config.representative_interval_s = o.representative_interval_s; break;
+      case kPlaceSamples: config.place_samples = o.place_samples; break;
     }
   }
   // --window alone asks for a window of that many frames (the time window is for --window-s).
