@@ -88,13 +88,14 @@ void runFilterBench(const TopologyBenchOptions& o, BenchRows& rows) {
     std::vector<double> step_ms, slice_ms;
     for (int k = 0; k < o.steps; ++k) {
       auto fingerprint = tagged(k % places);
+      const std::span<const std::shared_ptr<const Fingerprint>> samples = samplesOf(k % places);
       if (k % 2 == 0) {
         Stopwatch watch;
-        filter.step(fingerprint, {}, samplesOf(k % places));
+        filter.step(fingerprint, {}, samples);
         step_ms.push_back(watch.elapsedMs());
       } else {
         // Sliced: the pipeline's way of spreading a step over frames.
-        filter.beginStep(fingerprint, {}, samplesOf(k % places));
+        filter.beginStep(fingerprint, {}, samples);
         bool done = false;
         while (!done) {
           Stopwatch watch;

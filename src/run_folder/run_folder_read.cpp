@@ -62,6 +62,15 @@ bool quoteOpen(const std::string& record) {
 
 std::string where(const CsvTable& t, std::size_t row) { return t.path + ":" + std::to_string(t.lines[row]); }
 
+/// places.csv's `end`: one of placeEndName's values.
+bool isPlaceEndName(const std::string& name) {
+  for (PlaceEnd e : {PlaceEnd::Valley, PlaceEnd::ValleyAtDoorway, PlaceEnd::DoorwayPassage,
+                     PlaceEnd::InterruptedValley, PlaceEnd::StreamEnd}) {
+    if (name == placeEndName(e)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 CsvTable readCsv(const std::string& path) {
@@ -205,16 +214,6 @@ std::vector<FrameRecord> loadFrames(const std::string& path) {
   }
   return rows;
 }
-
-namespace {
-bool isPlaceEndName(const std::string& name) {
-  for (PlaceEnd e : {PlaceEnd::Valley, PlaceEnd::ValleyAtDoorway, PlaceEnd::DoorwayPassage,
-                     PlaceEnd::InterruptedValley, PlaceEnd::StreamEnd}) {
-    if (name == placeEndName(e)) return true;
-  }
-  return false;
-}
-}  // namespace
 
 std::vector<PlaceRecord> loadPlaces(const std::string& path) {
   const CsvTable t = readCsv(path);

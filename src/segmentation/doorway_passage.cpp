@@ -81,28 +81,7 @@ void DoorwayPassageDetector::addFrame(double time_s, int image_width, const std:
   next_tracks_.clear();
   for (const Track& track : tracks_) {
     const double last = track.lastOffset();
-    // An edge that has been moving out keeps moving out: a continuation must move out by at least
-    // min_outward_speed_fraction of the track's mean outward speed over its last fit_s seconds, less
-    // the inward jitter. A stalled edge where a fast one was expected is another edge (the jamb left
-    // the view and a far edge at the border took its place).
-    double min_growth = -0.25 * step;
-    if (config_.min_outward_speed_fraction > 0.0 && track.count >= 2) {
-      const int kept = std::min(track.count, kFitPoints);
-      int n = 1;
-      while (n < kept && track.time[static_cast<std::size_t>((track.count - 1 - n) % kFitPoints)] >=
-                             track.lastTime() - config_.fit_s - 1e-9) {
-        ++n;
-      }
-      if (n >= 2) {
-        const auto first = static_cast<std::size_t>((track.count - n) % kFitPoints);
-        const double span_s = track.lastTime() - track.time[first];
-        const double speed = span_s > 0.0 ? (last - track.offset[first]) / span_s : 0.0;
-        if (speed > 0.0) {
-          min_growth = std::max(min_growth, config_.min_outward_speed_fraction * speed *
-                                                    (time_s - track.lastTime()) - 0.25 * step);
-        }
-      }
-    }
+    const double min_growth = minContinuationGrowth(track, time_s, step);
     std::size_t best = edges;
     double best_growth = 0.0;
     for (std::size_t j = 0; j < edges; ++j) {
@@ -142,18 +121,38 @@ void DoorwayPassageDetector::addFrame(double time_s, int image_width, const std:
   std::erase_if(exits_, [&](const Exit& e) { return e.last_s < time_s - 2.0 * config_.max_lookahead_s; });
 }
 
+int DoorwayPassageDetector::recentPoints(const Track& track, int at_least) const {
+  const int kept = std::min(track.count, kFitPoints);
+  int n = 0;
+  while (n < kept && (n < at_least || track.time[static_cast<std::size_t>((track.count - 1 - n) % kFitPoints)] >=
+                                          track.lastTime() - config_.fit_s - 1e-9)) {
+    ++n;
+  }
+  return n;
+}
+
+double DoorwayPassageDetector::minContinuationGrowth(const Track& track, double time_s, double step) const {
+  // An edge that has been moving out keeps moving out: a continuation must move out by at least
+  // min_outward_speed_fraction of the track's mean outward speed over its last fit_s seconds, less the
+  // inward jitter. A stalled edge where a fast one was expected is another edge (the jamb left the view
+  // and a far edge at the border took its place).
+  const double jitter = 0.25 * step;
+  if (!(config_.min_outward_speed_fraction > 0.0)) return -jitter;
+  const int n = recentPoints(track, 1);
+  if (n < 2) return -jitter;
+  const auto first = static_cast<std::size_t>((track.count - n) % kFitPoints);
+  const double span_s = track.lastTime() - track.time[first];
+  const double speed = span_s > 0.0 ? (track.lastOffset() - track.offset[first]) / span_s : 0.0;
+  if (!(speed > 0.0)) return -jitter;
+  return std::max(-jitter, config_.min_outward_speed_fraction * speed * (time_s - track.lastTime()) - jitter);
+}
+
 void DoorwayPassageDetector::endTrack(const Track& track, double half_width) {
   if (track.count < config_.min_track_frames) return;
   if (track.lastOffset() < config_.border_fraction * half_width) return;
   // Least-squares line through (t, 1/|x|) over the track's last points, t relative to its last frame.
   const double last_s = track.lastTime();
-  const int kept = std::min(track.count, kFitPoints);
-  int n = 0;
-  while (n < kept && (n < config_.min_track_frames ||
-                      track.time[static_cast<std::size_t>((track.count - 1 - n) % kFitPoints)] >=
-                          last_s - config_.fit_s - 1e-9)) {
-    ++n;
-  }
+  const int n = recentPoints(track, config_.min_track_frames);
   double st = 0.0, sy = 0.0;
   for (int k = 0; k < n; ++k) {
     const auto i = static_cast<std::size_t>((track.count - 1 - k) % kFitPoints);

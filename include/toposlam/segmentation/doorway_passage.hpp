@@ -106,6 +106,12 @@ class DoorwayPassageDetector {
     double last_s;
     int side;
   };
+  /// How many of the track's newest points lie within fit_s of its last one (at least `at_least`, at
+  /// most the points kept): the points a fit or a speed is taken over.
+  int recentPoints(const Track& track, int at_least) const;
+  /// The least outward step (pixels) an edge at time_s must make to continue the track: the jitter
+  /// allowance, raised by min_outward_speed_fraction of the track's recent outward speed.
+  double minContinuationGrowth(const Track& track, double time_s, double step) const;
   /// A track that ended: records its predicted passage when it ended at the border.
   void endTrack(const Track& track, double half_width);
   void recordPassage(double passage_s);

@@ -306,11 +306,9 @@ class TopologyParticleFilter {
   std::size_t cursor_ = 0;
   std::shared_ptr<const Fingerprint> pending_;
   std::vector<std::shared_ptr<const Fingerprint>> pending_samples_;  ///< the place's other frames
-  /// Raw similarities of the samples, sample-major: [k * observations + o]; then the best relative
-  /// likelihood per observation.
-  std::vector<double> sample_similarity_;
-  std::vector<double> best_sample_likelihood_;
-  std::vector<double> representative_similarity_;
+  std::vector<double> sample_similarity_;          ///< raw, sample-major: [k * observations + o]
+  std::vector<double> best_sample_likelihood_;     ///< per observation, the best sample's relative likelihood
+  std::vector<double> representative_similarity_;  ///< the representative's raw similarities, set aside
   std::vector<StatePtr> groups_;        ///< distinct parent states, in order of first particle
   std::vector<std::int32_t> group_of_;  ///< per particle
   std::vector<unsigned char> needed_;   ///< per observation: referenced by some group
