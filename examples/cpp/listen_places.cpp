@@ -12,8 +12,10 @@
 static void onPlace(const lcm::ReceiveBuffer* buffer, const std::string&, long* seen) {
   toposlam_lcm::place_t p;
   if (p.decode(buffer->data, 0, static_cast<int>(buffer->data_size)) < 0) return;
-  std::printf("frame %lld place %d node %d p=%.2f\n", static_cast<long long>(p.frame), p.place, p.node,
-              static_cast<double>(p.probability));
+  // node: of the last place whose filter step finished; now: the node this frame is back in (the earlier frame
+  // it matches, p.match_frame, lies in it), -1 while it is no known node.
+  std::printf("frame %lld place %d node %d p=%.2f now %d\n", static_cast<long long>(p.frame), p.place, p.node,
+              static_cast<double>(p.probability), p.match_node);
   std::fflush(stdout);
   ++*seen;
 }

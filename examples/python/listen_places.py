@@ -15,7 +15,10 @@ try:
     with UdpmReader(sys.argv[2] if len(sys.argv) > 2 else DEFAULT_URL, channels=["TOPOSLAM_PLACE"]) as reader:
         for channel, payload in reader.messages(timeout=10):
             p = place_t.decode(payload)
-            print("frame %d place %d node %d p=%.2f" % (p.frame, p.place, p.node, p.probability), flush=True)
+            # node: of the last place whose filter step finished; now: the node this frame is back in (the
+            # earlier frame it matches, p.match_frame, lies in it), -1 while it is no known node.
+            print("frame %d place %d node %d p=%.2f now %d" % (p.frame, p.place, p.node, p.probability, p.match_node),
+                  flush=True)
             seen += 1
             if seen == count:
                 break

@@ -6,6 +6,7 @@
 
 #include <toposlam_lcm/place_event_t.hpp>
 #include <toposlam_lcm/place_t.hpp>
+#include <toposlam_lcm/place_v1_t.hpp>
 #include <toposlam_lcm/topology_t.hpp>
 
 #include "toposlam/platform/lcm_log.hpp"
@@ -33,15 +34,25 @@ LoggedRun readLoggedRun(const std::string& path, const LcmChannels& channels) {
     ++run.events;
     const std::string kind = channelKind(channels, event.channel);
     if (kind == "place") {
+      // A recording from before the per-frame answer holds place_v1_t: the same fields up to map_revision.
       toposlam_lcm::place_t m{};
-      if (!decodeEvent(event, kind, m)) {
+      LoggedFrame f;
+      if (decodeEvent(event, kind, m)) {
+        f.frame = m.frame;
+        f.time_s = static_cast<double>(m.utime) * 1e-6;
+        f.lambda2 = m.lambda2;
+        f.match_frame = m.match_frame;
+        f.match_score = m.match_score;
+        f.match_node = m.match_node;
+      } else if (toposlam_lcm::place_v1_t old{}; decodeEvent(event, "place_v1", old)) {
+        f.frame = old.frame;
+        f.time_s = static_cast<double>(old.utime) * 1e-6;
+        f.lambda2 = old.lambda2;
+      } else {
         ++run.malformed;
         continue;
       }
-      LoggedFrame f;
-      f.frame = m.frame;
-      f.time_s = static_cast<double>(m.utime) * 1e-6;
-      f.lambda2 = std::isfinite(m.lambda2) ? static_cast<double>(m.lambda2) : std::numeric_limits<double>::quiet_NaN();
+      if (!std::isfinite(f.lambda2)) f.lambda2 = std::numeric_limits<double>::quiet_NaN();
       run.frames.push_back(f);
     } else if (kind == "place_event") {
       toposlam_lcm::place_event_t m{};

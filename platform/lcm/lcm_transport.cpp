@@ -22,6 +22,7 @@
 #include "toposlam_lcm/motion_t.hpp"
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
+#include "toposlam_lcm/place_v1_t.hpp"
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
@@ -181,6 +182,10 @@ void LcmPipelineSink::publish(const FrameResult& r) {
       msg.alternatives.push_back(a);
     }
     msg.map_revision = e.map_revision;
+    msg.match_frame = r.revisit.match_frame;
+    msg.match_score = asFloat(r.revisit.score);
+    msg.match_place = r.revisit.match_place;
+    msg.match_node = r.revisit.match_node;
     // Stamped last, just before publishing: the latency the message carries includes its own encoding.
     msg.publish_utime = monotonicMicroseconds();
     timespec ts{};
@@ -319,7 +324,8 @@ class WireWalker {
   std::size_t pos_ = 0;
 };
 
-const WireSchema kPlace = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fixed(8)};
+const WireSchema kPlace = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fixed(8 + 8 + 4 * 3)};
+const WireSchema kPlaceV1 = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fixed(8)};  // before match_*
 const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length(), array(1), fixed(8)};
 const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
 const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
@@ -327,6 +333,28 @@ const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixe
 const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
 const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopologyNode), length(), array(12)};
 const WireSchema kMotion = {fixed(8 * 7 + 1)};
+
+/// An old recording's place message as today's, with no per-frame match.
+toposlam_lcm::place_t placeFromV1(const toposlam_lcm::place_v1_t& old) {
+  toposlam_lcm::place_t m{};
+  m.utime = old.utime;
+  m.publish_utime = old.publish_utime;
+  m.frame = old.frame;
+  m.latency_ms = old.latency_ms;
+  m.place = old.place;
+  m.node = old.node;
+  m.probability = old.probability;
+  m.is_new = old.is_new;
+  m.lambda2 = old.lambda2;
+  m.num_alternatives = old.num_alternatives;
+  m.alternatives = old.alternatives;
+  m.map_revision = old.map_revision;
+  m.match_frame = -1;
+  m.match_score = 0.0F;
+  m.match_place = -1;
+  m.match_node = -1;
+  return m;
+}
 
 template <typename Message>
 bool decodeMessage(const void* data, std::size_t size, Message& msg, const std::string& kind) {
@@ -343,6 +371,7 @@ bool decodeMessage(const void* data, std::size_t size, Message& msg, const std::
 
 bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size) {
   const WireSchema* schema = kind == "place"         ? &kPlace
+                             : kind == "place_v1"    ? &kPlaceV1
                              : kind == "place_event" ? &kPlaceEvent
                              : kind == "status"      ? &kStatus
                              : kind == "topology"    ? &kTopology
@@ -411,13 +440,22 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
   w.beginObject().field("channel", channel).field("kind", kind);
   bool ok = true;
   if (kind == "place") {
+    // Recordings from before the per-frame answer carry place_v1_t (its fingerprint differs): read as such,
+    // with no match.
     toposlam_lcm::place_t m{};
     ok = decodeMessage(data, size, m, kind);
+    if (!ok) {
+      toposlam_lcm::place_v1_t old{};
+      ok = decodeMessage(data, size, old, "place_v1");
+      if (ok) m = placeFromV1(old);
+    }
     if (ok) {
       out.frame = m.frame;
       out.node = m.node;
       out.place = m.place;
       out.is_new = m.is_new;
+      out.match_frame = m.match_frame;
+      out.match_node = m.match_node;
       w.field("utime", m.utime).field("publish_utime", m.publish_utime).field("frame", m.frame)
           .field("place", m.place).field("node", m.node);
       jsonNumber(w, "probability", m.probability);
@@ -430,11 +468,19 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
         jsonNumber(w, "probability", a.probability);
         w.endObject();
       }
-      w.endArray().field("map_revision", m.map_revision);
-      char line[256];
-      std::snprintf(line, sizeof line, "place  frame %6lld  place %3d  node %3d  p=%.2f%s  rev %lld  latency %.1f ms",
+      w.endArray().field("map_revision", m.map_revision).field("match_frame", m.match_frame);
+      jsonNumber(w, "match_score", m.match_score);
+      w.field("match_place", m.match_place).field("match_node", m.match_node);
+      char line[320];
+      char back[96] = "";
+      if (m.match_frame >= 0)
+        std::snprintf(back, sizeof back, "  back at frame %lld (place %d, node %d, score %.2f)",
+                      static_cast<long long>(m.match_frame), m.match_place, m.match_node,
+                      static_cast<double>(m.match_score));
+      std::snprintf(line, sizeof line, "place  frame %6lld  place %3d  node %3d  p=%.2f%s  rev %lld  latency %.1f ms%s",
                     static_cast<long long>(m.frame), m.place, m.node, static_cast<double>(m.probability),
-                    m.is_new ? " new" : "", static_cast<long long>(m.map_revision), static_cast<double>(m.latency_ms));
+                    m.is_new ? " new" : "", static_cast<long long>(m.map_revision), static_cast<double>(m.latency_ms),
+                    back);
       out.summary = line;
     }
   } else if (kind == "place_event") {

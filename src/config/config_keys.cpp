@@ -481,19 +481,24 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("topology.sequence_evidence.weight", AT(sequence_evidence.weight), 0.0, 0, 1, "",
                    "likelihood of an earlier place every keyframe of a new place detects into; 0 = off (it closes "
                    "look-alike stretches of one lap), 0.99 = on"));
+  k.push_back(flag("topology.sequence_evidence.frame_revisits", AT(sequence_evidence.frame_revisits), true,
+                   "run the sequence detector for every frame and publish its answer in place_t (match_frame, "
+                   "match_node: the node the robot is back in); the thesis preset has it off"));
   k.push_back(real("topology.sequence_evidence.min_share", AT(sequence_evidence.min_share), 0.8, 0, 1, "",
                    "share of a new place's keyframes an earlier place needs before it gets evidence"));
-  k.push_back(real("topology.sequence_evidence.min_score", AT(sequence_evidence.min_score), 0.1, 0, 1e6, "",
-                   "detection score D (integrated relative similarity) a keyframe needs to count"));
-  k.push_back(real("topology.sequence_evidence.min_relative", AT(sequence_evidence.min_relative), 0.0, -1e6, 1e6, "",
-                   "the keyframe's own relative similarity z with its detection needed to count"));
+  k.push_back(real("topology.sequence_evidence.min_score", AT(sequence_evidence.min_score), 2.0, 0, 1e6, "",
+                   "detection score (its noise's standard deviations) a frame's match needs to be published, and a "
+                   "keyframe's evidence to count"));
+  k.push_back(real("topology.sequence_evidence.min_relative", AT(sequence_evidence.min_relative), -1e6, -1e6, 1e6, "",
+                   "the keyframe's own relative similarity z with its match needed as well; -1e6: no such test"));
   k.push_back(real("topology.sequence_evidence.keyframe_interval_s", AT(sequence_evidence.loop.keyframe_interval_s), 1.0,
-                   0, 1e6, "s", "one keyframe at most this often"));
-  k.push_back(real("topology.sequence_evidence.decay", AT(sequence_evidence.loop.decay), 0.975, 0, 1, "",
-                   "evidence kept per keyframe along a diagonal")
-                  .exclusive(false, true));
-  k.push_back(integer("topology.sequence_evidence.min_gap_keyframes", AT(sequence_evidence.loop.min_gap_keyframes), 20,
-                      1, 1000000, "keyframes", "detections at least this many keyframes back"));
+                   0.01, 1e6, "s", "one keyframe at most this often"));
+  k.push_back(real("topology.sequence_evidence.memory_s", AT(sequence_evidence.memory_s), 40.0, 0.02, 1e6, "s",
+                   "the longest memory of a run of matches (time constant); must exceed the keyframe interval"));
+  k.push_back(integer("topology.sequence_evidence.scales", AT(sequence_evidence.loop.scales), 3, 1, 8, "",
+                      "memories integrated side by side, each 4 times shorter than the one before"));
+  k.push_back(real("topology.sequence_evidence.min_gap_s", AT(sequence_evidence.min_gap_s), 20.0, 0.01, 1e6, "s",
+                   "matches at least this long back"));
   // Large maps (CandidateSelectionConfig; docs/topology.md): exhaustive up to a size, then an index.
   k.push_back(integer("topology.candidates.exhaustive_up_to", AT(topology.candidates.exhaustive_up_to), 1000, 0,
                       1000000000, "representatives",
@@ -648,7 +653,8 @@ const std::vector<ConfigSection>& daemonConfigSections() {
       {"topology", "particle filter over topologies (thesis ch. 5, docs/topology.md)"},
       {"topology.candidates", "large maps: which stored places a new one is compared with (docs/topology.md)"},
       {"topology.sequence_evidence",
-       "runs of frames as the filter's second evidence (docs/topology.md, \"Sequence evidence in the filter\")"},
+       "the sequence detector: whether each frame is back at an earlier one (place_t's match_*) and, with a weight, "
+       "runs of frames as the filter's second evidence (docs/topology.md, \"The per-frame answer\")"},
   };
   return sections;
 }

@@ -192,6 +192,7 @@ void applyMethodPreset(const std::string& name, DaemonConfig& c) {
   c.similarity = preset.similarity;
   c.segmentation = preset.segmentation;
   c.topology = preset.topology;
+  c.sequence_evidence = preset.sequence_evidence;
 }
 
 DaemonConfig::DaemonConfig() {

@@ -68,6 +68,7 @@ MethodPreset methodPreset(const std::string& name) {
     p.topology.gamma_scale = 0.25;
     p.topology.new_node_entropy = true;
     p.topology.new_node_likelihood_floor = 0.0;
+    p.sequence_evidence.frame_revisits = false;  // not in the thesis: no per-frame answer
   }
   return p;
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -34,7 +35,9 @@ FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig&
                                                    const SequenceEvidenceConfig& evidence)
     : similarity_(similarity),
       segmenter_(std::in_place, config, similarity),
-      evidence_(evidence.weight > 0.0 ? std::make_unique<PlaceSequenceEvidence>(evidence, similarity) : nullptr),
+      evidence_(evidence.weight > 0.0 || evidence.frame_revisits ? std::make_unique<PlaceSequenceEvidence>(evidence, similarity)
+                                                                  : nullptr),
+      evidence_to_filter_(evidence.weight > 0.0),
       max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)),
       gate_(motion) {
   thumbnails_.reserve(max_thumbnails_ + 1);
@@ -95,7 +98,8 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
     spdlog::warn("segmentation: frame {}'s source time went back {:.3f} s (to {:.3f} s); the window's clock carries on "
                  "from the frame before ({} such steps so far)",
                  sequence, timeline_.lastStepBackS(), source_time_s, steps_back + 1);
-  if (evidence_) evidence_->addFrame(sequence, time_s, fingerprint);
+  FrameRevisit revisit;
+  if (evidence_) revisit = evidence_->addFrame(sequence, time_s, fingerprint);
   SegmenterStep step = segmenter_->addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   if (motion_counters_ != nullptr) {
     const MotionUse use = last_motion_.known ? MotionUse::Used : gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
@@ -106,6 +110,8 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   last_closed_.reset();
   if (step.lambda2) out.lambda2 = *step.lambda2;
   if (step.closed_place) out.closed = toClosedPlace(*step.closed_place);
+  out.revisit.match_frame = revisit.match_frame;
+  out.revisit.score = revisit.score;
   return out;
 }
 
@@ -143,7 +149,10 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
     place.keypoints = p.representative_keypoints;
     place.representative = p.representative;
     place.samples.assign(p.samples.begin(), p.samples.begin() + p.sample_count);
-    if (evidence_) place.evidence = evidence_->closePlace(p.first_frame, p.last_frame);
+    if (evidence_) {
+      std::vector<double> evidence = evidence_->closePlace(p.first_frame, p.last_frame);
+      if (evidence_to_filter_) place.evidence = std::move(evidence);
+    }
     const auto it = std::find_if(thumbnails_.begin(), thumbnails_.end(),
                                  [&](const auto& entry) { return entry.first == p.representative_frame; });
     if (it != thumbnails_.end()) place.thumbnail = it->second;
@@ -207,6 +216,8 @@ std::optional<FinishedPlace> ParticleFilterTopologyStage::advance(double budget_
       FinishedPlace done{std::move(queue_.front()), PlaceAssignment{}};
       queue_.pop_front();
       representative_frames_.push_back(done.place.representative_frame);
+      if (spans_.empty() || done.place.first_frame > spans_.back().last_frame)
+        spans_.push_back({done.place.first_frame, done.place.last_frame, filter_->observationCount() - 1});
       if (done.place.last_frame > last_mapped_frame_) {
         last_mapped_frame_ = done.place.last_frame;
         last_mapped_name_ = name_of_ ? name_of_(last_mapped_frame_) : std::string();
@@ -258,8 +269,26 @@ void ParticleFilterTopologyStage::refresh() {
     }
     for (const auto& [ends, count] : edges) t.edges.push_back({ends.first, ends.second, count});
   }
+  node_of_observation_.assign(static_cast<std::size_t>(observations), -1);
+  for (const TopologyNode& n : t.nodes)
+    for (const int observation : n.places)
+      if (observation >= 0 && observation < observations) node_of_observation_[static_cast<std::size_t>(observation)] = n.id;
   estimate_ = std::move(e);
   topology_ = std::move(t);
+}
+
+void ParticleFilterTopologyStage::locate(RevisitEstimate& r) const {
+  r.match_place = -1;
+  r.match_node = -1;
+  if (r.match_frame < 0) return;
+  // The last span starting at or before the frame, if it reaches it.
+  const auto it = std::upper_bound(spans_.begin(), spans_.end(), r.match_frame,
+                                   [](std::int64_t f, const PlaceSpan& s) { return f < s.first_frame; });
+  if (it == spans_.begin() || r.match_frame > std::prev(it)->last_frame) return;
+  const int observation = std::prev(it)->observation;
+  r.match_place = observation;
+  if (observation >= 0 && static_cast<std::size_t>(observation) < node_of_observation_.size())
+    r.match_node = node_of_observation_[static_cast<std::size_t>(observation)];
 }
 
 namespace {

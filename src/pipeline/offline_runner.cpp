@@ -42,6 +42,7 @@ SegmenterStep OfflineRunner::segment(double source_time_s, const std::string& na
   if (!std::isnan(stage_step.lambda2)) step.lambda2 = stage_step.lambda2;
   row.lambda2 = step.lambda2;
   run_.frames.push_back(std::move(row));
+  revisits_.push_back(stage_step.revisit);
   pending_ = std::move(stage_step.closed);
   if (segmentation_.lastClosedPlace()) {
     step.closed_place = *segmentation_.lastClosedPlace();

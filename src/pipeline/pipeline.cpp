@@ -333,6 +333,7 @@ void Pipeline::segmentationLoop() {
                                                        std::move(in.fingerprint),
                                                        in.thumbnail);
       in.result.lambda2 = step.lambda2;
+      in.result.revisit = step.revisit;
       if (step.closed) in.result.closed_place = std::move(step.closed);
       in.result.segmentation_ms = (clock_.now() - t0) * 1e3;
       if (!forward(*segmented_, std::move(in.result))) break;
@@ -415,6 +416,7 @@ void Pipeline::topologyLoop() {
   };
   auto stampEstimate = [&](FrameResult& r) {
     r.estimate = topology_.estimate();
+    topology_.locate(r.revisit);
     map_revision_.store(r.estimate.map_revision);
     if (r.estimate.map_revision != published_revision) {
       r.topology = std::make_shared<const TopologySnapshot>(topology_.topology());

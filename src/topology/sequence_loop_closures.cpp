@@ -22,20 +22,30 @@ std::string SequenceLoopConfig::validate() const {
   if (!(keyframe_interval_s >= 0.0) || !std::isfinite(keyframe_interval_s))
     return "keyframe interval must be a finite number of seconds >= 0 (got " + std::to_string(keyframe_interval_s) + ")";
   if (!(decay >= 0.0 && decay < 1.0)) return "loop decay must be in [0, 1) (got " + std::to_string(decay) + ")";
+  if (scales < 1 || scales > 8) return "loop scales must be 1 .. 8 (got " + std::to_string(scales) + ")";
+  if (!(scale_ratio >= 1.0 && scale_ratio <= 100.0))
+    return "loop scale ratio must be in [1, 100] (got " + std::to_string(scale_ratio) + ")";
+  if (align_keyframes < 0 || align_keyframes > 1000)
+    return "loop alignment must be 0 .. 1000 keyframes (got " + std::to_string(align_keyframes) + ")";
   if (min_gap_keyframes < 1) return "loop minimum gap must be at least 1 keyframe (got " + std::to_string(min_gap_keyframes) + ")";
   if (!(sigma_floor > 0.0) || !std::isfinite(sigma_floor))
     return "loop sigma floor must be > 0 (got " + std::to_string(sigma_floor) + ")";
   return {};
 }
 
+double SequenceLoopConfig::decayOf(int k) const {
+  return std::max(0.0, 1.0 - (1.0 - decay) * std::pow(scale_ratio, k));
+}
+
 SequenceLoopDetector::SequenceLoopDetector(SequenceLoopConfig config) : config_(config) {
   if (const std::string problem = config_.validate(); !problem.empty())
     throw std::invalid_argument("SequenceLoopDetector: " + problem);
+  integrated_.resize(static_cast<std::size_t>(config_.scales));
 }
 
 SequenceLoopDetector::Detection SequenceLoopDetector::add(const std::vector<double>& similarities,
                                                           bool continues_previous) {
-  const std::size_t n = integrated_.size();  // earlier keyframes
+  const std::size_t n = starts_run_.size();  // earlier keyframes
   if (similarities.size() != n)
     throw std::invalid_argument("SequenceLoopDetector::add: " + std::to_string(similarities.size()) +
                                 " similarities for " + std::to_string(n) + " earlier keyframes");
@@ -49,85 +59,66 @@ SequenceLoopDetector::Detection SequenceLoopDetector::add(const std::vector<doub
     sigma = std::sqrt(sigma / static_cast<double>(n));
   }
   const double spread = std::max(sigma, config_.sigma_floor);
-  // D(f, g) = (1 - decay) z_g + decay D(f-1, g-1), carried only where both f-1 -> f and g-1 -> g are
-  // steps of one traversal (g = 0 and the first keyframe of a traversal start a diagonal).
-  if (next_.capacity() < n + 1) next_.reserve(2 * (n + 1));  // the two buffers swap: grow both geometrically
-  next_.assign(n + 1, 0.0);  // one more slot: the new keyframe's own entry for the next call
-  for (std::size_t g = 0; g < n; ++g) {
-    const double z = n >= 2 ? (similarities[g] - mean) / spread : 0.0;
-    const double carried = continues_previous && g >= 1 && !starts_run_[g] ? integrated_[g - 1] : 0.0;
-    next_[g] = (1.0 - config_.decay) * z + config_.decay * carried;
-  }
+  z_.assign(n, 0.0);
+  if (n >= 2)
+    for (std::size_t g = 0; g < n; ++g) z_[g] = (similarities[g] - mean) / spread;
+  // Per memory k: D_k(f, g) = (1 - d_k) z_g + d_k D_k(f-1, g-1), carried only where both f-1 -> f and
+  // g-1 -> g are steps of one traversal (g = 0 and the first keyframe of a traversal start a diagonal).
   Detection best;
   const auto gap = static_cast<std::size_t>(config_.min_gap_keyframes);
-  if (n >= gap) {
-    for (std::size_t g = 0; g + gap <= n; ++g) {
-      if (next_[g] > 0.0 && (best.keyframe < 0 || next_[g] > best.score)) {
-        best.keyframe = static_cast<std::int64_t>(g);
-        best.score = next_[g];
-        best.relative = n >= 2 ? (similarities[g] - mean) / spread : 0.0;
+  for (std::size_t k = 0; k < integrated_.size(); ++k) {
+    const double d = config_.decayOf(static_cast<int>(k));
+    const double noise = std::sqrt((1.0 - d) / (1.0 + d));
+    std::vector<double>& integrated = integrated_[k];
+    if (next_.capacity() < n + 1) next_.reserve(2 * (n + 1));  // the buffers swap: grow geometrically
+    next_.assign(n + 1, 0.0);  // one more slot: the new keyframe's own entry for the next call
+    for (std::size_t g = 0; g < n; ++g) {
+      const double carried = continues_previous && g >= 1 && !starts_run_[g] ? integrated[g - 1] : 0.0;
+      next_[g] = (1.0 - d) * z_[g] + d * carried;
+    }
+    if (n >= gap) {
+      for (std::size_t g = 0; g + gap <= n; ++g) {
+        const double score = next_[g] / noise;
+        if (next_[g] > 0.0 && (best.diagonal < 0 || score > best.score)) {
+          best.diagonal = static_cast<std::int64_t>(g);
+          best.score = score;
+        }
       }
     }
+    integrated.swap(next_);
   }
-  integrated_.swap(next_);
+  if (best.diagonal >= 0) {
+    // Alignment: the most similar keyframe around the diagonal's end (first of equals), never too recent.
+    const auto end = static_cast<std::size_t>(best.diagonal);
+    const auto align = static_cast<std::size_t>(config_.align_keyframes);
+    const std::size_t lo = end >= align ? end - align : 0;
+    const std::size_t hi = std::min(end + align, n - gap);
+    std::size_t at = end;
+    for (std::size_t g = lo; g <= hi; ++g)
+      if (similarities[g] > similarities[at]) at = g;
+    best.keyframe = static_cast<std::int64_t>(at);
+    best.relative = z_[end];  // the diagonal's own (the best of a few neighbours would stand out by chance)
+  }
   starts_run_.push_back(n == 0 || !continues_previous);
   return best;
 }
 
-std::vector<FrameMatch> matchFramesBySequence(const std::vector<double>& time_s,
-                                              const std::vector<std::shared_ptr<const Fingerprint>>& fingerprints,
-                                              const SimilarityMeasure& similarity, const SequenceLoopConfig& config) {
-  if (time_s.size() != fingerprints.size()) throw std::invalid_argument("matchFramesBySequence: sizes differ");
-  SequenceLoopDetector detector(config);
-  const auto frames = static_cast<std::int64_t>(fingerprints.size());
-  std::vector<FrameMatch> out(fingerprints.size());
-  std::vector<std::int64_t> keyframe_frames;  // frame index of each keyframe
-  std::vector<double> row;
-  // The most similar frame with a fingerprint in [centre - half, centre + half], before `before`.
-  const auto refine = [&](std::int64_t f, std::int64_t centre, std::int64_t half, std::int64_t before, FrameMatch& m) {
-    for (std::int64_t c = std::max<std::int64_t>(0, centre - half); c <= std::min(centre + half, before - 1); ++c) {
-      const auto& candidate = fingerprints[static_cast<std::size_t>(c)];
-      if (!candidate) continue;
-      const double s = similarity.symmetricSimilarity(*candidate, *fingerprints[static_cast<std::size_t>(f)]);
-      if (m.match_frame < 0 || s > m.similarity) {
-        m.match_frame = c;
-        m.similarity = s;
-      }
-    }
-  };
-  std::int64_t last_key = -1;          // frame index of the latest keyframe
-  std::int64_t last_key_match = -1;    // its detected frame (-1: none)
-  std::int64_t half_spacing = 0;       // half the frames between the last two keyframes
-  double last_key_score = 0.0;
-  for (std::int64_t f = 0; f < frames; ++f) {
-    const auto& fp = fingerprints[static_cast<std::size_t>(f)];
-    if (!fp) continue;
-    const double t = time_s[static_cast<std::size_t>(f)];
-    const bool keyframe =
-        isKeyframe(last_key < 0, t, last_key < 0 ? 0.0 : time_s[static_cast<std::size_t>(last_key)], config.keyframe_interval_s);
-    if (keyframe) {
-      row.clear();
-      for (const std::int64_t k : keyframe_frames)
-        row.push_back(std::clamp(similarity.symmetricSimilarity(*fingerprints[static_cast<std::size_t>(k)], *fp), 0.0, 1.0));
-      // A clock that goes back starts a new traversal: no diagonal runs across it.
-      const bool continues = last_key >= 0 && t >= time_s[static_cast<std::size_t>(last_key)];
-      const SequenceLoopDetector::Detection d = detector.add(row, continues);
-      half_spacing = last_key < 0 ? 0 : (f - last_key) / 2;
-      keyframe_frames.push_back(f);
-      last_key = f;
-      last_key_match = d.keyframe >= 0 ? keyframe_frames[static_cast<std::size_t>(d.keyframe)] : -1;
-      last_key_score = d.score;
-    }
-    if (last_key_match < 0) continue;
-    FrameMatch& m = out[static_cast<std::size_t>(f)];
-    refine(f, last_key_match + (f - last_key), half_spacing, f, m);
-    if (m.match_frame >= 0) m.score = last_key_score;
-  }
-  return out;
+SequenceLoopConfig SequenceEvidenceConfig::loopConfig() const {
+  SequenceLoopConfig c = loop;
+  c.decay = 1.0 - loop.keyframe_interval_s / memory_s;
+  c.min_gap_keyframes = static_cast<int>(std::ceil(min_gap_s / loop.keyframe_interval_s - 1e-9));
+  return c;
 }
 
 std::string SequenceEvidenceConfig::validate() const {
-  if (std::string problem = loop.validate(); !problem.empty()) return problem;
+  if (!(loop.keyframe_interval_s > 0.0) || !std::isfinite(loop.keyframe_interval_s))
+    return "keyframe interval must be a finite number of seconds > 0 (got " + std::to_string(loop.keyframe_interval_s) + ")";
+  if (!(memory_s > loop.keyframe_interval_s) || !std::isfinite(memory_s))
+    return "sequence memory must be longer than the keyframe interval (got " + std::to_string(memory_s) + " s)";
+  if (!(min_gap_s >= loop.keyframe_interval_s) || !std::isfinite(min_gap_s) || min_gap_s / loop.keyframe_interval_s > 1e6)
+    return "sequence minimum gap must be at least one keyframe interval and at most a million of them (got " +
+           std::to_string(min_gap_s) + " s)";
+  if (std::string problem = loopConfig().validate(); !problem.empty()) return problem;
   if (!(min_score >= 0.0) || !std::isfinite(min_score))
     return "sequence evidence minimum score must be a finite number >= 0 (got " + std::to_string(min_score) + ")";
   if (!std::isfinite(min_relative))
@@ -138,32 +129,52 @@ std::string SequenceEvidenceConfig::validate() const {
   return {};
 }
 
-PlaceSequenceEvidence::PlaceSequenceEvidence(const SequenceEvidenceConfig& config, const SimilarityMeasure& similarity)
-    : config_(config), similarity_(similarity), detector_(config.loop) {
-  if (const std::string problem = config_.validate(); !problem.empty())
+namespace {
+
+const SequenceEvidenceConfig& validated(const SequenceEvidenceConfig& config) {
+  if (const std::string problem = config.validate(); !problem.empty())
     throw std::invalid_argument("PlaceSequenceEvidence: " + problem);
+  return config;
 }
 
-void PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
-                                     const std::shared_ptr<const Fingerprint>& fingerprint) {
-  if (!fingerprint || !std::isfinite(time_s)) return;
+}  // namespace
+
+PlaceSequenceEvidence::PlaceSequenceEvidence(const SequenceEvidenceConfig& config, const SimilarityMeasure& similarity)
+    : config_(validated(config)), similarity_(similarity), detector_(config_.loopConfig()) {}
+
+FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
+                                             const std::shared_ptr<const Fingerprint>& fingerprint) {
+  if (!fingerprint || !std::isfinite(time_s)) return {};
   if (!keyframe_frames_.empty() && frame <= keyframe_frames_.back())
     throw std::invalid_argument("PlaceSequenceEvidence::addFrame: frame " + std::to_string(frame) +
                                 " after frame " + std::to_string(keyframe_frames_.back()));
   const bool first = keyframe_frames_.empty();
-  if (!isKeyframe(first || traversal_break_, time_s, last_keyframe_time_s_, config_.loop.keyframe_interval_s)) return;
+  if (!isKeyframe(first || traversal_break_, time_s, last_keyframe_time_s_, config_.loop.keyframe_interval_s)) {
+    // Between keyframes: the keyframe's match, moved on by as many frames as this one lies after it.
+    FrameRevisit shifted = last_keyframe_revisit_;
+    if (shifted.match_frame >= 0) shifted.match_frame += frame - last_keyframe_;
+    if (shifted.match_frame >= last_keyframe_) shifted = FrameRevisit{};
+    return shifted;
+  }
   const bool continues = !first && !traversal_break_ && time_s >= last_keyframe_time_s_;
   row_.clear();
   for (const auto& earlier : keyframe_fingerprints_)
     row_.push_back(std::clamp(similarity_.symmetricSimilarity(*earlier, *fingerprint), 0.0, 1.0));
   const SequenceLoopDetector::Detection d = detector_.add(row_, continues);
   KeyframeDetection record{frame, -1};
-  if (d.keyframe >= 0 && d.score >= config_.min_score && d.relative >= config_.min_relative) record.matched_frame = keyframe_frames_[static_cast<std::size_t>(d.keyframe)];
+  FrameRevisit revisit;
+  if (d.keyframe >= 0 && d.score >= config_.min_score && d.relative >= config_.min_relative) {
+    record.matched_frame = keyframe_frames_[static_cast<std::size_t>(d.keyframe)];
+    revisit = FrameRevisit{record.matched_frame, d.score};
+  }
   open_detections_.push_back(record);
   keyframe_fingerprints_.push_back(fingerprint);
   keyframe_frames_.push_back(frame);
   last_keyframe_time_s_ = time_s;
   traversal_break_ = false;
+  last_keyframe_ = frame;
+  last_keyframe_revisit_ = revisit;
+  return revisit;
 }
 
 std::int64_t PlaceSequenceEvidence::placeOfFrame(std::int64_t frame) const {

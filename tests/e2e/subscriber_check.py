@@ -113,8 +113,14 @@ def collect(url, ready_path):
     for p in places:
         check(-1 <= p.place and -1 <= p.node and 0.0 <= p.probability <= 1.0 and p.latency_ms >= 0.0,
               "place_t out of range: frame %d place %d node %d p=%f latency %f" % (p.frame, p.place, p.node, p.probability, p.latency_ms))
+        check(-1 <= p.match_frame < p.frame and (p.match_frame >= 0 or (p.match_node == -1 and p.match_place == -1)),
+              "place_t's match out of range: frame %d match_frame %d place %d node %d" % (p.frame, p.match_frame, p.match_place, p.match_node))
         check(p.num_alternatives == len(p.alternatives), "num_alternatives %d, %d alternatives" % (p.num_alternatives, len(p.alternatives)))
         check(math.isnan(p.lambda2) or p.lambda2 >= -1e-6, "lambda2 %f < 0" % p.lambda2)
+    # The second lap is back where the first went: most of its frames name the earlier frame and its node.
+    back = [p for p in places if p.frame >= FRAMES // 2 and p.match_frame >= 0 and p.match_node >= 0]
+    check(len(back) >= 0.5 * sum(1 for p in places if p.frame >= FRAMES // 2),
+          "only %d second-lap frames name an earlier frame's node" % len(back))
     revisions = [p.map_revision for p in places]
     check(all(b >= a for a, b in zip(revisions, revisions[1:])), "map_revision decreased")
     mapped = [p for p in places if p.place >= 0]
@@ -163,10 +169,11 @@ def example_output(path, minimum):
     check(len(lines) >= minimum, "%s: %d lines, expected >= %d" % (path, len(lines), minimum))
     frames = []
     for words in lines:
-        check(len(words) == 7 and words[0::2][:3] == ["frame", "place", "node"] and words[6].startswith("p="),
-              "%s: unexpected line %r" % (path, " ".join(words)))
-        frame, place, node, p = int(words[1]), int(words[3]), int(words[5]), float(words[6][2:])
-        check(0 <= frame < FRAMES and place >= -1 and node >= -1 and 0.0 <= p <= 1.0, "%s: out of range: %r" % (path, " ".join(words)))
+        check(len(words) == 9 and words[0::2][:3] == ["frame", "place", "node"] and words[6].startswith("p=")
+              and words[7] == "now", "%s: unexpected line %r" % (path, " ".join(words)))
+        frame, place, node, p, now = int(words[1]), int(words[3]), int(words[5]), float(words[6][2:]), int(words[8])
+        check(0 <= frame < FRAMES and place >= -1 and node >= -1 and 0.0 <= p <= 1.0 and now >= -1,
+              "%s: out of range: %r" % (path, " ".join(words)))
         frames.append(frame)
     check(all(b > a for a, b in zip(frames, frames[1:])), "%s: frames not increasing" % path)
     check(max(int(w[3]) for w in lines) >= 0, "%s: no place stepped in %d lines" % (path, len(lines)))

@@ -16,6 +16,7 @@
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
+#include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
 namespace toposlam {
@@ -26,6 +27,8 @@ struct MethodPreset {
   NgramSimilarityConfig similarity;
   FiedlerSegmenterConfig segmentation;
   TopologyFilterConfig topology;
+  /// The sequence detector: its per-frame answer (on in "default", off in "thesis") and its evidence.
+  SequenceEvidenceConfig sequence_evidence;
 };
 
 /// "default" or "thesis"; throws std::invalid_argument naming the allowed names otherwise.

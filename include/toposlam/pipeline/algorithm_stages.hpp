@@ -95,7 +95,8 @@ struct MotionSample {
 class FiedlerSegmentationStage final : public SegmentationStage {
  public:
   /// `evidence` with weight > 0: every closed place carries the sequence evidence of its frames
-  /// (ClosedPlace::evidence; docs/topology.md). The default has weight 0: none.
+  /// (ClosedPlace::evidence; docs/topology.md). The default has weight 0: none. With
+  /// evidence.frame_revisits (or weight > 0) every frame gets the detector's answer (SegmentationStep::revisit).
   FiedlerSegmentationStage(const FiedlerSegmenterConfig& config, const SimilarityMeasure& similarity,
                            std::size_t max_thumbnails = 600, const MotionGateConfig& motion = {},
                            const SequenceEvidenceConfig& evidence = {});
@@ -145,7 +146,8 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 
   const SimilarityMeasure& similarity_;
   std::optional<FiedlerSegmenter> segmenter_;        ///< always set; a fresh one per traversal
-  std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: no sequence evidence
+  std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: no sequence detector
+  bool evidence_to_filter_ = false;                  ///< closed places carry its evidence (weight > 0)
   std::size_t max_thumbnails_;
   /// (frame, thumbnail) of the open place's frames, in arrival order; capacity max_thumbnails_ reserved
   /// once, so a frame costs no node allocation.
@@ -200,6 +202,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   bool idle() const override { return queue_.empty() && !filter_->stepInProgress(); }
   const PlaceEstimate& estimate() const override { return estimate_; }
   TopologySnapshot topology() const override { return topology_; }
+  void locate(RevisitEstimate& r) const override;
   std::unique_ptr<const MapSnapshot> snapshotMap() const override;
 
   int observations() const { return filter_->observationCount(); }
@@ -224,6 +227,13 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   std::string last_mapped_name_;         ///< its name ("" unnamed: not recorded)
   int run_first_observation_ = 0;  ///< observation of this run's first place (after a loaded map)
   std::vector<double> step_evidence_;  ///< scratch: the evidence by observation
+  /// This run's stepped places, in step order (frames increase): where a matched frame lies.
+  struct PlaceSpan {
+    std::int64_t first_frame = 0, last_frame = 0;
+    int observation = -1;
+  };
+  std::vector<PlaceSpan> spans_;
+  std::vector<int> node_of_observation_;  ///< in the most probable topology (refresh())
   std::int64_t revision_ = 0;
   PlaceEstimate estimate_;
   TopologySnapshot topology_;

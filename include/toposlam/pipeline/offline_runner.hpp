@@ -67,6 +67,9 @@ class OfflineRunner {
 
   /// Frames and places of every traversal so far, run numbering (representatives not kept).
   const SegmentationRun& run() const { return run_; }
+  /// Every frame's per-frame answer (the sequence detector's match, as toposlamd publishes it in place_t),
+  /// in run numbering; match_frame -1 without one. Empty matches when the detector is off.
+  const std::vector<RevisitEstimate>& revisits() const { return revisits_; }
   /// The filter steps of this run, in order.
   const std::vector<MappedPlace>& steps() const { return steps_; }
   /// Node of every kept place of this run in the filter's most probable topology (call between steps;
@@ -87,6 +90,7 @@ class OfflineRunner {
   bool open_ = false;                  ///< a traversal is open (frames given since its start)
   std::optional<ClosedPlace> pending_;  ///< the kept place the segmentation stage closed last, for mapPlace()
   SegmentationRun run_;
+  std::vector<RevisitEstimate> revisits_;
   std::vector<MappedPlace> steps_;
 };
 

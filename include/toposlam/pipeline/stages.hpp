@@ -38,10 +38,21 @@ struct ClosedPlace {
   std::vector<double> evidence;
 };
 
+/// Whether the robot is back, frame by frame (docs/topology.md, "The per-frame answer"): the earlier frame
+/// this frame matches by the sequence detector, and where that frame lies in the map. The segmentation
+/// stage fills match_frame and score; the topology stage, match_place and match_node.
+struct RevisitEstimate {
+  std::int64_t match_frame = -1;  ///< the earlier frame the robot is back at; -1: not back, or not known yet
+  double score = 0.0;             ///< the detector's score (integrated relative similarity), 0 without a match
+  int match_place = -1;           ///< the place holding match_frame (-1: none, or its filter step is not done)
+  int match_node = -1;            ///< that place's node in the most probable topology: the node the robot is in now
+};
+
 /// What segmentation says after one frame.
 struct SegmentationStep {
   double lambda2 = std::numeric_limits<double>::quiet_NaN();  ///< Fiedler value; NaN until defined
   std::optional<ClosedPlace> closed;                          ///< a place closed by this frame
+  RevisitEstimate revisit;                                    ///< the frame's match (match_frame, score)
 };
 
 /// The topology filter's decision for one place, once its (spread) step has finished.
@@ -165,6 +176,11 @@ class TopologyStage {
   virtual const PlaceEstimate& estimate() const = 0;
   /// The most probable topology as of the last finished step.
   virtual TopologySnapshot topology() const = 0;
+  /// Fills r.match_place and r.match_node for r.match_frame (both -1 when no finished place holds it).
+  virtual void locate(RevisitEstimate& r) const {
+    r.match_place = -1;
+    r.match_node = -1;
+  }
   /// The map as it is now, to be written by MapSnapshot::writeTo() from any thread. Only called when
   /// idle(). Throws std::runtime_error (or a subclass) if the map cannot be encoded.
   virtual std::unique_ptr<const MapSnapshot> snapshotMap() const = 0;
@@ -246,6 +262,7 @@ struct FrameResult {
   double lambda2 = std::numeric_limits<double>::quiet_NaN();
   std::optional<ClosedPlace> closed_place;  ///< closed by segmentation on this frame (its step is queued)
   PlaceEstimate estimate;
+  RevisitEstimate revisit;                     ///< whether this frame is back at an earlier one, and where
   std::vector<FinishedPlace> finished_places;  ///< steps finished on this frame
   std::shared_ptr<const TopologySnapshot> topology;  ///< set when the topology changed on this frame
 };

@@ -1,18 +1,24 @@
-// Frame-level loop closures by sequence evidence (docs/topology.md, "Frame level by sequences"): the
-// default way `toposlam map` gives every frame its best-matching earlier frame and a score.
+// Frame-level loop closures by sequence evidence (docs/topology.md, "Frame level by sequences"): run online
+// in the segmentation stage, the one data path of toposlamd and `toposlam map`, it gives every frame, as it
+// arrives, its best-matching earlier frame and a score (place_t's match_*, frames.csv's match columns).
 //
 // A single frame's similarity cannot say *whether* the robot is back (on the corridor set a first-lap
 // frame matches an earlier frame of the same corridor as well as a revisit does); a run of frames that
 // keep matching a run of earlier frames in step can. So, at keyframes (one per `keyframe_interval_s`):
 //   1. the keyframe's similarities s_g to every earlier keyframe g are made relative to each other,
 //      z_g = (s_g - mean) / max(std, sigma_floor), so a frame that resembles everything scores nothing;
-//   2. each z_g is integrated along the diagonal (keyframe f against g continues f-1 against g-1):
-//      D(f, g) = (1 - decay) z_g + decay D(f-1, g-1), a leaky sum over the last 1 / (1 - decay) keyframes,
-//      never across the start of a traversal (where the keyframes' clock goes back);
-//   3. the detection is the g at least `min_gap_keyframes` back with the largest D, when D > 0, scored D.
-// A frame between keyframes takes its latest keyframe's score and, as its match, the most similar frame
-// around the keyframe's match shifted by the same number of frames (the robot retraces at about the
-// speed of the first visit).
+//   2. each z_g is integrated along the diagonal (keyframe f against g continues f-1 against g-1) at
+//      `scales` memories, the longest `decay` per keyframe and each next one `scale_ratio` times shorter:
+//      D_k(f, g) = (1 - d_k) z_g + d_k D_k(f-1, g-1), never across the start of a traversal (where the
+//      keyframes' clock goes back);
+//   3. each D_k is measured in its own noise: were the z independent with unit spread, D_k would spread by
+//      sigma_k = sqrt((1 - d_k) / (1 + d_k)); the score of g is max_k D_k(f, g) / sigma_k, so a short run
+//      of strong matches and a long run of weak ones are judged on one scale, and the stream's own
+//      similarity statistics (step 1) set it: nothing to retune per data set;
+//   4. the detection is the g at least `min_gap_keyframes` back with the largest score, when its D > 0;
+//      its match is the keyframe within `align_keyframes` of g that the new keyframe resembles most.
+// A frame between keyframes takes its latest keyframe's score and, as its match, the keyframe's match
+// shifted by the same number of frames (the robot retraces at about the speed of its first visit).
 //
 // Pure: plain vectors in, the similarity measure; no clock, no I/O. Deterministic.
 #pragma once
@@ -25,18 +31,25 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
-#include "toposlam/topology/frame_loop_closures.hpp"
 
 namespace toposlam {
 
 struct SequenceLoopConfig {
   double keyframe_interval_s = 1.0;  ///< a keyframe at most this often (every frame of a 1 Hz sequence)
-  double decay = 0.975;              ///< per keyframe: evidence of the last ~40 keyframes
+  double decay = 0.975;              ///< per keyframe, of the longest memory: evidence of the last ~40 keyframes
+  int scales = 1;                    ///< memories integrated side by side, 1 .. 8
+  double scale_ratio = 4.0;          ///< each next memory this many times shorter: 1 - d_{k+1} = ratio (1 - d_k)
   int min_gap_keyframes = 20;        ///< detections at least this many keyframes back
   double sigma_floor = 0.01;         ///< keeps z finite when the earlier similarities are all alike
+  /// The detection's diagonal says *that* the robot is back; the match is the keyframe within this many
+  /// keyframes of the diagonal's end that the new keyframe resembles most (the two visits' speeds differ a
+  /// little, and a diagonal carried past the end of the earlier visit points where the robot is not).
+  int align_keyframes = 1;
 
   /// Empty when valid, else what is wrong (names the setting).
   std::string validate() const;
+  /// The decay of memory k (0: the longest), clamped to >= 0.
+  double decayOf(int k) const;
 };
 
 /// The keyframe part: one add() per keyframe, in time order. Keeps one integrated value per earlier
@@ -46,9 +59,10 @@ class SequenceLoopDetector {
   explicit SequenceLoopDetector(SequenceLoopConfig config);
 
   struct Detection {
-    std::int64_t keyframe = -1;  ///< the detected earlier keyframe, -1: none
-    double score = 0.0;          ///< integrated relative similarity D (> 0 when detected)
-    double relative = 0.0;       ///< this keyframe's own z with the detected one (not integrated)
+    std::int64_t keyframe = -1;  ///< the detected earlier keyframe (aligned), -1: none
+    double score = 0.0;          ///< the best diagonal's D_k / sigma_k (> 0 when detected)
+    double relative = 0.0;       ///< this keyframe's own z with the diagonal's end (not integrated)
+    std::int64_t diagonal = -1;  ///< where the best diagonal ends, before alignment
   };
 
   /// similarities[g]: the new keyframe against earlier keyframe g, for every g < keyframes().
@@ -56,12 +70,13 @@ class SequenceLoopDetector {
   /// keyframe into it, nor from the keyframe before it into it later on).
   Detection add(const std::vector<double>& similarities, bool continues_previous = true);
 
-  std::int64_t keyframes() const { return static_cast<std::int64_t>(integrated_.size()); }
+  std::int64_t keyframes() const { return static_cast<std::int64_t>(starts_run_.size()); }
 
  private:
   SequenceLoopConfig config_;
-  std::vector<double> integrated_;  ///< D(latest keyframe, g) for g < latest
-  std::vector<double> next_;        ///< scratch, reused
+  std::vector<std::vector<double>> integrated_;  ///< per memory: D_k(latest keyframe, g) for g < latest
+  std::vector<double> next_;                     ///< scratch, reused
+  std::vector<double> z_;                        ///< scratch: this keyframe's relative similarities
   std::vector<bool> starts_run_;    ///< per keyframe: the first of its traversal
 };
 
@@ -72,21 +87,44 @@ class SequenceLoopDetector {
 /// the representatives' own (the larger of the two counts). A revisit that single frames cannot tell from
 /// a look-alike (a corridor) is then closed on the run of frames that keeps matching in step.
 struct SequenceEvidenceConfig {
-  SequenceLoopConfig loop;
-  double min_score = 0.1;  ///< the detection's D needed to count (the corridor's first lap stays below 0.05)
+  /// The detector's settings: keyframe_interval_s, scales and the rest as given; its decay and minimum gap
+  /// are made from memory_s and min_gap_s below (loopConfig()), so every setting is in seconds.
+  SequenceLoopConfig loop{1.0, 0.975, 3, 4.0, 20};
+  double memory_s = 40.0;   ///< the longest memory's time constant: decay = 1 - keyframe interval / memory_s
+  double min_gap_s = 20.0;  ///< detections at least this long back
+  /// The detection's score (in its noise's standard deviations, SequenceLoopDetector) needed to count: to
+  /// be published as a frame's match and to vote for the filter's evidence.
+  double min_score = 2.0;
   /// Likelihood of an earlier place every keyframe of the new place detects into; 0 = off (the default:
   /// it closes look-alike stretches of one lap, docs/topology.md). 0.99 when turned on.
   double weight = 0.0;
   /// The keyframe's own relative similarity z with the detected keyframe needed to count: a run's evidence
   /// fades slowly after the revisit ends, and without this the diagonal it leaves behind keeps voting.
-  double min_relative = 0.0;
+  /// -1e6 (the default): no such test; measured, it cost the real samples a right frame and the corridor two
+  /// (docs/topology.md, "The per-frame answer").
+  double min_relative = -1e6;
   /// The share of the new place's keyframes an earlier place needs before it gets any evidence: weak
   /// evidence would otherwise decide (eq. 5.7's new-node likelihood falls with the entropy of the known
   /// nodes' likelihoods, so one small but lone likelihood beats a new node).
   double min_share = 0.8;
+  /// Run the detector for the per-frame answer (FrameRevisit: the earlier frame each frame is back at,
+  /// published in place_t) even when the filter takes no evidence (weight 0). Off in the thesis preset.
+  bool frame_revisits = true;
 
   /// Empty when valid, else what is wrong (names the setting).
   std::string validate() const;
+  /// `loop` with its decay and minimum gap from memory_s and min_gap_s.
+  SequenceLoopConfig loopConfig() const;
+};
+
+/// The per-frame answer of the sequence detector: the earlier frame this frame is back at, when the run of
+/// keyframes ending at the frame's keyframe says so (its detection's D >= min_score and its own relative
+/// similarity z >= min_relative: the same test that makes a keyframe vote for the filter's evidence, so the
+/// frame-level answer and the evidence agree). A frame between keyframes takes its keyframe's match shifted
+/// by as many frames as it lies after its keyframe (the robot retraces at about the speed of its first visit).
+struct FrameRevisit {
+  std::int64_t match_frame = -1;  ///< the earlier frame, -1: not back (or not known yet)
+  double score = 0.0;             ///< the keyframe's integrated relative similarity D (0 without a match)
 };
 
 /// Online, one instance per stream (the daemon's segmentation stage, `toposlam map`). Keeps the keyframes'
@@ -98,7 +136,8 @@ class PlaceSequenceEvidence {
 
   /// Every frame in stream order (frame numbers increasing). A null fingerprint is skipped. A time that
   /// goes back, or the first frame after beginTraversal(), starts a new traversal.
-  void addFrame(std::int64_t frame, double time_s, const std::shared_ptr<const Fingerprint>& fingerprint);
+  /// Returns the frame's answer (no match for a skipped frame).
+  FrameRevisit addFrame(std::int64_t frame, double time_s, const std::shared_ptr<const Fingerprint>& fingerprint);
   /// The next frame starts a traversal of its own (a new source).
   void beginTraversal() { traversal_break_ = true; }
   /// A kept place [first_frame, last_frame] closed (its frames were all added): returns one likelihood per
@@ -118,6 +157,8 @@ class PlaceSequenceEvidence {
   std::vector<std::int64_t> keyframe_frames_;
   double last_keyframe_time_s_ = 0.0;
   bool traversal_break_ = true;
+  std::int64_t last_keyframe_ = -1;  ///< frame of the latest keyframe
+  FrameRevisit last_keyframe_revisit_;  ///< its answer
   struct KeyframeDetection {
     std::int64_t frame = -1;          ///< the keyframe
     std::int64_t matched_frame = -1;  ///< its detection (-1: none that counts)
@@ -126,12 +167,5 @@ class PlaceSequenceEvidence {
   std::vector<std::pair<std::int64_t, std::int64_t>> places_;  ///< kept places' frame ranges, in order
   std::vector<double> row_;                                     ///< scratch
 };
-
-/// Whole runs: time_s[f] per frame (a time that goes back starts a new traversal: that frame is a
-/// keyframe), fingerprints[f] may be null (never a keyframe or a candidate). Returns one FrameMatch per
-/// frame (similarity: with the match; score: the keyframe's D).
-std::vector<FrameMatch> matchFramesBySequence(const std::vector<double>& time_s,
-                                              const std::vector<std::shared_ptr<const Fingerprint>>& fingerprints,
-                                              const SimilarityMeasure& similarity, const SequenceLoopConfig& config);
 
 }  // namespace toposlam

@@ -70,12 +70,9 @@ struct MapOptions {
   bool json = false;                     ///< --json: the summary as one JSON object on stdout
   CLI::Option* frame_loops_given = nullptr;
   int loop_min_gap = 10;  ///< visits: detections at least this many frames back
-  SequenceLoopConfig sequence_loops;  ///< sequence: keyframes, decay, gap
-  double sequence_evidence = SequenceEvidenceConfig{}.weight;  ///< 0: off
-  double sequence_evidence_min_score = SequenceEvidenceConfig{}.min_score;
-  double sequence_evidence_min_relative = SequenceEvidenceConfig{}.min_relative;
-  double sequence_evidence_min_share = SequenceEvidenceConfig{}.min_share;
-  double loop_min_gap_s = 20.0;       ///< sequence: detections at least this long back
+  /// The sequence detector and its evidence (--loop-*, --keyframe-interval-s, --sequence-evidence*); the
+  /// default preset's, frame_revisits from --frame-loops.
+  SequenceEvidenceConfig sequence = methodPreset("default").sequence_evidence;
   int max_keypoints = -1;             ///< -1: the preset's
   CandidateSelectionConfig candidates;  ///< large maps: --exhaustive-up-to, --candidates
   std::string likelihood = toString(methodPreset("default").topology.likelihood);
@@ -159,22 +156,16 @@ VpackConfig fingerprintConfig(const MapOptions& o, const MethodPreset& preset) {
   return vpack;
 }
 
-/// How frame-level loop closures are found (docs/topology.md): by sequence or by visits to a node.
+/// How frame-level loop closures are found (docs/topology.md): by sequence, online (the per-frame answer
+/// toposlamd publishes), or by visits to a node of the final topology.
 struct FrameLoopPlan {
   bool by_sequence = true;
-  SequenceLoopConfig sequence_loops;  ///< with min_gap_keyframes from --loop-min-gap-s
 };
 
 FrameLoopPlan frameLoopPlan(const MapOptions& o, const MethodPreset& preset) {
   FrameLoopPlan plan;
   // The thesis has no frame-level detector of its own: its preset reads frame closures off the topology.
   plan.by_sequence = o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
-  plan.sequence_loops = o.sequence_loops;
-  const double keyframe_interval_s = std::max(plan.sequence_loops.keyframe_interval_s, 1e-9);
-  plan.sequence_loops.min_gap_keyframes =
-      std::max(1, static_cast<int>(std::lround(o.loop_min_gap_s / keyframe_interval_s)));
-  if (const std::string problem = plan.sequence_loops.validate(); !problem.empty())
-    throw std::invalid_argument("map: " + problem);
   return plan;
 }
 
@@ -255,13 +246,9 @@ StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const 
 }
 
 /// The filter's sequence evidence (docs/topology.md) from the --sequence-evidence options.
-SequenceEvidenceConfig sequenceEvidenceConfig(const MapOptions& o, const SequenceLoopConfig& sequence_loops) {
-  SequenceEvidenceConfig evidence;
-  evidence.loop = sequence_loops;
-  evidence.weight = o.sequence_evidence;
-  evidence.min_score = o.sequence_evidence_min_score;
-  evidence.min_relative = o.sequence_evidence_min_relative;
-  evidence.min_share = o.sequence_evidence_min_share;
+SequenceEvidenceConfig sequenceEvidenceConfig(const MapOptions& o, bool by_sequence) {
+  SequenceEvidenceConfig evidence = o.sequence;
+  evidence.frame_revisits = by_sequence;
   if (const std::string problem = evidence.validate(); !problem.empty())
     throw std::invalid_argument("map: " + problem);
   return evidence;
@@ -372,8 +359,8 @@ void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const Method
           : "off";
   const std::string frame_loops =
       loops.by_sequence
-          ? "sequence, decay " + real(loops.sequence_loops.decay) + ", at least " + real(o.loop_min_gap_s) +
-                " s back"
+          ? "sequence, online, memories " + real(evidence.memory_s) + " s (" + std::to_string(evidence.loop.scales) +
+                " scales), at least " + real(evidence.min_gap_s) + " s back, score at least " + real(evidence.min_score)
           : "visits, at least " + std::to_string(o.loop_min_gap) + " frames back";
   writeSettings(out_dir, {{"toposlam", TOPOSLAM_VERSION},
                           {"preset", preset.name},
@@ -412,13 +399,20 @@ std::vector<FrameRecord> frameRowsWithLoopClosures(
     if (p < place_probability.size()) place_probability[p] = step.estimate.current_node_probability;
   }
   frame_fingerprints.resize(all.frames.size());
-  std::vector<double> time_s;
-  for (const auto& row : all.frames) time_s.push_back(row.time_s);
-  const std::vector<FrameMatch> matches =
-      !loops.by_sequence
-          ? matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
-                                       similarity, loop_min_gap)
-          : matchFramesBySequence(time_s, frame_fingerprints, similarity, loops.sequence_loops);
+  // By sequence: the answer every frame got online, as it arrived (what toposlamd publishes in place_t).
+  // By visits (the thesis preset): read off the final topology.
+  std::vector<FrameMatch> matches;
+  if (loops.by_sequence) {
+    for (const RevisitEstimate& r : runner.revisits()) {
+      FrameMatch m;
+      m.match_frame = r.match_frame;
+      m.score = r.score;
+      matches.push_back(m);
+    }
+  } else {
+    matches = matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
+                                         similarity, loop_min_gap);
+  }
   for (std::size_t f = 0; f < frame_rows.size(); ++f) {
     FrameRecord& row = frame_rows[f];
     if (row.place >= 0 && static_cast<std::size_t>(row.place) < place_probability.size())
@@ -599,7 +593,7 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const TopologyParticleFilter& filter = topology.filter();
   const int first_observation = filter.observationCount();
 
-  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, loops.sequence_loops);
+  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, loops.by_sequence);
   // Thumbnails are the daemon's (place events); the offline run keeps none.
   FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
   OfflineRunner runner(fingerprint_stage, segmentation_stage, &topology);
@@ -672,32 +666,37 @@ void addMapCommand(CLI::App& app) {
                   "Frame-level loop closures (visits): detections at least this many frames back")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--loop-min-gap-s", options->loop_min_gap_s,
+  cmd->add_option("--loop-min-gap-s", options->sequence.min_gap_s,
                   "Frame-level loop closures (sequence): detections at least this many seconds back")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e9));
-  cmd->add_option("--loop-decay", options->sequence_loops.decay,
-                  "Frame-level loop closures (sequence): evidence kept per keyframe, in [0, 1)")
+      ->check(keyRange("topology.sequence_evidence.min_gap_s"));
+  cmd->add_option("--loop-memory-s", options->sequence.memory_s,
+                  "Frame-level loop closures (sequence): the longest memory of the run of matches, seconds")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.999999));
-  cmd->add_option("--keyframe-interval-s", options->sequence_loops.keyframe_interval_s,
+      ->check(keyRange("topology.sequence_evidence.memory_s"));
+  cmd->add_option("--loop-scales", options->sequence.loop.scales,
+                  "Frame-level loop closures (sequence): memories side by side, each 4 times shorter")
+      ->capture_default_str()
+      ->check(keyRange("topology.sequence_evidence.scales"));
+  cmd->add_option("--keyframe-interval-s", options->sequence.loop.keyframe_interval_s,
                   "Frame-level loop closures (sequence): one keyframe at most this often")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--sequence-evidence", options->sequence_evidence,
+      ->check(keyRange("topology.sequence_evidence.keyframe_interval_s"));
+  cmd->add_option("--sequence-evidence", options->sequence.weight,
                   "Filter: likelihood of an earlier place that every keyframe of the new place detects into (the "
                   "sequence detector's evidence, docs/topology.md; 0 = off, 0.99 = on)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--sequence-evidence-min-score", options->sequence_evidence_min_score,
-                  "Filter: the detection score D a keyframe needs for its evidence to count")
-      ->check(CLI::Range(0.0, 1e6))
+  cmd->add_option("--sequence-evidence-min-score", options->sequence.min_score,
+                  "The detection score (standard deviations of its noise) a frame's match needs to be published, "
+                  "and a keyframe's evidence to count")
+      ->check(keyRange("topology.sequence_evidence.min_score"))
       ->capture_default_str();
-  cmd->add_option("--sequence-evidence-min-relative", options->sequence_evidence_min_relative,
+  cmd->add_option("--sequence-evidence-min-relative", options->sequence.min_relative,
                   "Filter: the keyframe's own relative similarity z with its detection needed for its evidence to count")
       ->check(CLI::Range(-1e6, 1e6))
       ->capture_default_str();
-  cmd->add_option("--sequence-evidence-min-share", options->sequence_evidence_min_share,
+  cmd->add_option("--sequence-evidence-min-share", options->sequence.min_share,
                   "Filter: the share of the new place's keyframes an earlier place needs before it gets evidence")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();

@@ -37,10 +37,20 @@ void writeRunFolderFromLog(const LoggedRun& run, const std::string& log_path, co
   // Per frame: time (NaN until known), lambda2, place, node.
   std::vector<double> time(n, std::nan("")), lambda2(n, std::nan(""));
   std::vector<int> place(n, -1), node(n, -1);
+  // The per-frame answer as published (place_t.match_*): frames.csv's loop-closure columns, so `eval`
+  // scores exactly what a subscriber received.
+  std::vector<std::int64_t> match(n, -1);
+  std::vector<double> match_score(n, 0.0);
+  bool any_match = false;
   for (const LoggedFrame& f : run.frames) {
     if (f.frame < 0) continue;
     time[static_cast<std::size_t>(f.frame)] = f.time_s;
     lambda2[static_cast<std::size_t>(f.frame)] = f.lambda2;
+    if (f.match_frame >= 0 && f.match_frame < f.frame) {
+      match[static_cast<std::size_t>(f.frame)] = f.match_frame;
+      match_score[static_cast<std::size_t>(f.frame)] = f.match_score;
+      any_match = true;
+    }
   }
   // Missing times: interpolated between the known neighbours (held at the ends).
   std::size_t previous = n;
@@ -78,8 +88,10 @@ void writeRunFolderFromLog(const LoggedRun& run, const std::string& log_path, co
     frames[i].lambda2 = lambda2[i];
     frames[i].place = place[i];
     frames[i].node = node[i];
+    frames[i].match = match[i];
+    frames[i].match_score = match_score[i];
   }
-  writeFrames(dir, frames, FrameColumns::Segmentation);
+  writeFrames(dir, frames, any_match ? FrameColumns::WithLoopClosures : FrameColumns::Segmentation);
   std::vector<PlaceRecord> places;
   for (const LoggedPlace& p : run.places)
     places.push_back(PlaceRecord{p.place, 0, p.first_frame, p.last_frame, p.representative_frame, p.keypoints,

@@ -19,6 +19,7 @@
 #include "toposlam_lcm/motion_t.hpp"
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
+#include "toposlam_lcm/place_v1_t.hpp"
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
@@ -58,6 +59,7 @@ FrameResult fullFrameResult() {
   r.estimate.is_new = false;
   r.estimate.alternatives = {{1, 0.25}, {-1, 0.125}};
   r.estimate.map_revision = 9;
+  r.revisit = RevisitEstimate{4'000'000'110, 3.25, 6, 2};  // back at frame ..110 of place 6, node 2
   ClosedPlace place;
   place.place = 7;
   place.first_frame = 4'000'000'100;
@@ -203,6 +205,10 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(m.alternatives[1].node == -1);
     CHECK(m.alternatives[1].probability == 0.125f);
     CHECK(m.map_revision == 9);
+    CHECK(m.match_frame == 4'000'000'110);
+    CHECK(m.match_score == 3.25f);
+    CHECK(m.match_place == 6);
+    CHECK(m.match_node == 2);
   }
   SECTION("status_t: the pipeline's counters, the camera, motion and every stage") {
     const auto m = decodeAs<toposlam_lcm::status_t>(events[3]);
@@ -257,9 +263,33 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(received[2].kind == "place");
     CHECK(received[2].frame == 5'000'000'123);
     CHECK((received[2].place == 7 && received[2].node == 3));
+    CHECK((received[2].match_frame == 4'000'000'110 && received[2].match_node == 2));
+    CHECK_THAT(received[2].summary, Catch::Contains("back at frame 4000000110 (place 6, node 2, score 3.25)"));
+    CHECK_THAT(received[2].json, Catch::Contains("\"match_node\":2"));
     CHECK(received[3].kind == "status");
     CHECK_THAT(received[3].json, Catch::Contains("\"frames_captured\":3000000001"));
   }
+}
+
+TEST_CASE("GIVEN a place message recorded before match_* existed (place_v1_t) WHEN decoded THEN it reads with no match",
+          "[platform][lcm]") {
+  toposlam_lcm::place_v1_t old{};
+  old.frame = 41;
+  old.place = 2;
+  old.node = 1;
+  old.num_alternatives = 1;
+  old.alternatives.resize(1);
+  old.alternatives[0].node = 0;
+  old.map_revision = 3;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(old.getEncodedSize()));
+  REQUIRE(old.encode(bytes.data(), 0, static_cast<int>(bytes.size())) == static_cast<int>(bytes.size()));
+  ReceivedMessage out;
+  REQUIRE(decodeLcmMessage("place", "TOPOSLAM_PLACE", bytes.data(), bytes.size(), out));
+  CHECK((out.frame == 41 && out.place == 2 && out.node == 1));
+  CHECK((out.match_frame == -1 && out.match_node == -1));
+  CHECK_THAT(out.json, Catch::Contains("\"match_frame\":-1"));
+  // Cut short, neither type reads it.
+  CHECK_FALSE(decodeLcmMessage("place", "TOPOSLAM_PLACE", bytes.data(), bytes.size() - 1, out));
 }
 
 TEST_CASE("GIVEN a motion_t with every field set WHEN encoded and decoded THEN every field comes back, and "

@@ -44,6 +44,9 @@ TEST_CASE("GIVEN encoded place, status and topology messages WHEN checked THEN t
     CHECK_FALSE(lcmArrayLengthsFit("place", bad.data(), bad.size()));
   }
   CHECK_FALSE(lcmArrayLengthsFit("place", bytes.data(), bytes.size() - 1));  // truncated
+  // A place message as recorded before match_* existed (place_v1_t): 20 bytes shorter, its own schema.
+  CHECK_FALSE(lcmArrayLengthsFit("place", bytes.data(), bytes.size() - 20));
+  CHECK(lcmArrayLengthsFit("place_v1", bytes.data(), bytes.size() - 20));
   CHECK_FALSE(lcmArrayLengthsFit("no-such-kind", bytes.data(), bytes.size()));
 
   toposlam_lcm::status_t status{};

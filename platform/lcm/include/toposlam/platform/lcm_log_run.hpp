@@ -21,6 +21,9 @@ struct LoggedFrame {
   std::int64_t frame = 0;
   double time_s = 0.0;  ///< place_t.utime: the frame's capture time from its source, seconds
   double lambda2 = std::numeric_limits<double>::quiet_NaN();
+  std::int64_t match_frame = -1;  ///< place_t.match_frame: the earlier frame it is back at, -1: none
+  double match_score = 0.0;
+  int match_node = -1;
 };
 
 struct LoggedPlace {

@@ -83,6 +83,8 @@ struct ReceivedMessage {
   int node = -1;            ///< place and place_event: the node
   int place = -1;
   bool is_new = false;
+  std::int64_t match_frame = -1;  ///< place messages: the earlier frame this one is back at (-1: none)
+  int match_node = -1;            ///< place messages: the node the robot is in now (-1: not a known node)
   // motion messages: motion_t.utime in seconds (host CLOCK_MONOTONIC), hypot(forward_m, lateral_m),
   // |linear_velocity_mps| and |angular_velocity_rps|; time NaN for other kinds.
   double motion_time_s = std::numeric_limits<double>::quiet_NaN();
@@ -92,7 +94,7 @@ struct ReceivedMessage {
 };
 
 /// True when every array length field of an encoded message of `kind` (place, place_event, status,
-/// topology, motion) is >= 0 and fits in the bytes that follow it, so decoding allocates no more than the
+/// topology, motion; place_v1: a place message recorded before match_* existed) is >= 0 and fits in the bytes that follow it, so decoding allocates no more than the
 /// message's own size. LcmSubscriber refuses (counts as malformed) a message for which this is false.
 bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size);
 
