@@ -36,6 +36,7 @@
 #include "bench_stats.hpp"
 #include "benchmarks.hpp"
 #include "image_input.hpp"
+#include "synthetic_places.hpp"
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/svg_plot.hpp"
@@ -99,38 +100,6 @@ class TimedSimilarity final : public SimilarityMeasure {
   const SimilarityMeasure& inner_;
   mutable std::chrono::steady_clock::duration elapsed_{};
 };
-
-double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-void flipBits(cv::Mat& descriptors, int row, double probability, std::mt19937_64& rng) {
-  auto* bytes = descriptors.ptr<std::uint8_t>(row);
-  for (int b = 0; b < descriptors.cols * 8; ++b)
-    if (uniform(rng) < probability) bytes[b >> 3] = static_cast<std::uint8_t>(bytes[b >> 3] ^ (1u << (b & 7)));
-}
-
-/// A new place: the donor's structure, its own keypoints and colours.
-Fingerprint prototypeOf(const Fingerprint& donor, std::mt19937_64& rng) {
-  Fingerprint f = donor;
-  f.descriptors = donor.descriptors.clone();
-  for (int r = 0; r < f.descriptors.rows; ++r) flipBits(f.descriptors, r, 0.35, rng);
-  std::array<int, kHueBins> hue{};
-  for (int i = 0; i < kHueBins; ++i) hue[static_cast<std::size_t>(i)] = i;
-  for (int i = kHueBins - 1; i > 0; --i) std::swap(hue[static_cast<std::size_t>(i)], hue[static_cast<std::size_t>(rng() % (i + 1))]);
-  for (Subregion& s : f.subregions) {
-    HclHistogramBins bins = s.histogram;
-    for (int i = 0; i < kHueBins; ++i) bins[static_cast<std::size_t>(hue[static_cast<std::size_t>(i)])] = s.histogram[static_cast<std::size_t>(i)];
-    s.histogram = bins;
-  }
-  return f;
-}
-
-/// Seeing the place again: a few bits of every keypoint change, 30 % of the keypoints are other ones.
-std::shared_ptr<const Fingerprint> observationOf(const Fingerprint& prototype, std::mt19937_64& rng) {
-  auto f = std::make_shared<Fingerprint>(prototype);
-  f->descriptors = prototype.descriptors.clone();
-  for (int r = 0; r < f->descriptors.rows; ++r) flipBits(f->descriptors, r, uniform(rng) < 0.3 ? 0.5 : 0.04, rng);
-  return f;
-}
 
 /// The decision: where the robot is, as the most probable current node over all particles (its founding
 /// observation; -1 before the first step). Not the node in the single most probable topology, which

@@ -14,6 +14,7 @@ void addBenchSim(CLI::App& bench);           // sim
 void addBenchMatching(CLI::App& bench);      // similarity
 void addBenchPipeline(CLI::App& bench);      // pipeline
 void addBenchMapSize(CLI::App& bench);       // map-size
+void addBenchRevisits(CLI::App& bench);      // revisits: the per-frame answer's cost per keyframe
 void addBenchStartup(CLI::App& bench);       // startup: toposlam's own start-up, as child processes
 
 }  // namespace toposlam::cli

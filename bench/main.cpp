@@ -25,6 +25,7 @@ int run(int argc, char** argv) {
   toposlam::cli::addBenchMatching(app);
   toposlam::cli::addBenchPipeline(app);
   toposlam::cli::addBenchMapSize(app);
+  toposlam::cli::addBenchRevisits(app);
   toposlam::cli::addBenchStartup(app);
   return toposlam::cli::runCommandLine(app, argc, argv, "toposlam-bench");
 }

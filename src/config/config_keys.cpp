@@ -497,6 +497,16 @@ std::vector<ConfigKey> makeKeys() {
                    "the longest memory of a run of matches (time constant); must exceed the keyframe interval"));
   k.push_back(integer("topology.sequence_evidence.scales", AT(sequence_evidence.loop.scales), 3, 1, 8, "",
                       "memories integrated side by side, each 4 times shorter than the one before"));
+  k.push_back(integer("topology.sequence_evidence.exhaustive_up_to", AT(sequence_evidence.exhaustive_up_to), 1000, 0,
+                      1000000000, "keyframes",
+                      "compare a keyframe with every earlier one up to this many; beyond, only the candidate index's "
+                      "finds, the live runs' next steps and a fixed sample for the statistics (a bounded cost)"));
+  k.push_back(integer("topology.sequence_evidence.candidates", AT(sequence_evidence.candidates), 32, 1, 10000, "keyframes",
+                      "large maps: keyframes the candidate index proposes per keyframe"));
+  k.push_back(integer("topology.sequence_evidence.diagonals", AT(sequence_evidence.diagonals), 32, 1, 10000, "",
+                      "large maps: runs of matches followed per memory"));
+  k.push_back(integer("topology.sequence_evidence.statistics_sample", AT(sequence_evidence.statistics_sample), 128, 2,
+                      100000, "keyframes", "large maps: keyframes compared for the similarities' mean and spread"));
   k.push_back(real("topology.sequence_evidence.min_gap_s", AT(sequence_evidence.min_gap_s), 20.0, 0.01, 1e6, "s",
                    "matches at least this long back"));
   // Large maps (CandidateSelectionConfig; docs/topology.md): exhaustive up to a size, then an index.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <stdexcept>
 
 namespace toposlam {
@@ -62,6 +63,47 @@ SequenceLoopDetector::Detection SequenceLoopDetector::add(const std::vector<doub
   z_.assign(n, 0.0);
   if (n >= 2)
     for (std::size_t g = 0; g < n; ++g) z_[g] = (similarities[g] - mean) / spread;
+  return integrate(similarities, continues_previous);
+}
+
+SequenceLoopDetector::Detection SequenceLoopDetector::addSparse(const std::vector<double>& similarities, double mean,
+                                                                double spread, bool continues_previous) {
+  const std::size_t n = starts_run_.size();
+  if (similarities.size() != n)
+    throw std::invalid_argument("SequenceLoopDetector::addSparse: " + std::to_string(similarities.size()) +
+                                " similarities for " + std::to_string(n) + " earlier keyframes");
+  spread = std::max(spread, config_.sigma_floor);
+  z_.assign(n, 0.0);
+  if (n >= 2)
+    for (std::size_t g = 0; g < n; ++g)
+      if (!std::isnan(similarities[g])) z_[g] = (similarities[g] - mean) / spread;
+  return integrate(similarities, continues_previous);
+}
+
+std::vector<std::size_t> SequenceLoopDetector::continuations(std::size_t per_memory) const {
+  std::vector<std::size_t> out;
+  std::vector<std::pair<double, std::size_t>> live;
+  for (const std::vector<double>& integrated : integrated_) {
+    live.clear();
+    // integrated holds D(latest, g) for g < latest and the latest keyframe's own slot (0).
+    for (std::size_t g = 0; g + 1 < integrated.size(); ++g)
+      if (integrated[g] > 0.0) live.emplace_back(integrated[g], g);
+    const std::size_t keep = std::min(per_memory, live.size());
+    std::partial_sort(live.begin(), live.begin() + static_cast<std::ptrdiff_t>(keep), live.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+    for (std::size_t i = 0; i < keep; ++i)
+      for (std::size_t g = live[i].second; g <= live[i].second + 2; ++g) out.push_back(g);  // (g + 1) +- 1
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  const std::size_t n = starts_run_.size();  // the next keyframe's earlier keyframes: 0 .. n - 1
+  while (!out.empty() && out.back() >= n) out.pop_back();
+  return out;
+}
+
+SequenceLoopDetector::Detection SequenceLoopDetector::integrate(const std::vector<double>& similarities,
+                                                                bool continues_previous) {
+  const std::size_t n = starts_run_.size();
   // Per memory k: D_k(f, g) = (1 - d_k) z_g + d_k D_k(f-1, g-1), carried only where both f-1 -> f and
   // g-1 -> g are steps of one traversal (g = 0 and the first keyframe of a traversal start a diagonal).
   Detection best;
@@ -95,7 +137,7 @@ SequenceLoopDetector::Detection SequenceLoopDetector::add(const std::vector<doub
     const std::size_t hi = std::min(end + align, n - gap);
     std::size_t at = end;
     for (std::size_t g = lo; g <= hi; ++g)
-      if (similarities[g] > similarities[at]) at = g;
+      if (!std::isnan(similarities[g]) && (std::isnan(similarities[at]) || similarities[g] > similarities[at])) at = g;
     best.keyframe = static_cast<std::int64_t>(at);
     best.relative = z_[end];  // the diagonal's own (the best of a few neighbours would stand out by chance)
   }
@@ -126,6 +168,11 @@ std::string SequenceEvidenceConfig::validate() const {
   if (!(min_share >= 0.0 && min_share <= 1.0))
     return "sequence evidence minimum share must be in [0, 1] (got " + std::to_string(min_share) + ")";
   if (!(weight >= 0.0 && weight <= 1.0)) return "sequence evidence weight must be in [0, 1] (got " + std::to_string(weight) + ")";
+  if (exhaustive_up_to < 0) return "sequence exhaustive_up_to must be >= 0 keyframes (got " + std::to_string(exhaustive_up_to) + ")";
+  if (candidates < 1 || candidates > 10000) return "sequence candidates must be 1 .. 10000 (got " + std::to_string(candidates) + ")";
+  if (diagonals < 1 || diagonals > 10000) return "sequence diagonals must be 1 .. 10000 (got " + std::to_string(diagonals) + ")";
+  if (statistics_sample < 2 || statistics_sample > 100000)
+    return "sequence statistics_sample must be 2 .. 100000 (got " + std::to_string(statistics_sample) + ")";
   return {};
 }
 
@@ -157,10 +204,24 @@ FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
     return shifted;
   }
   const bool continues = !first && !traversal_break_ && time_s >= last_keyframe_time_s_;
-  row_.clear();
-  for (const auto& earlier : keyframe_fingerprints_)
-    row_.push_back(std::clamp(similarity_.symmetricSimilarity(*earlier, *fingerprint), 0.0, 1.0));
-  const SequenceLoopDetector::Detection d = detector_.add(row_, continues);
+  const std::size_t n = keyframe_fingerprints_.size();
+  const bool indexed = PlaceCandidateIndex::supports(*fingerprint);
+  SequenceLoopDetector::Detection d;
+  if (!indexed || index_ == nullptr || n <= static_cast<std::size_t>(config_.exhaustive_up_to)) {
+    row_.clear();
+    for (const auto& earlier : keyframe_fingerprints_)
+      row_.push_back(std::clamp(similarity_.symmetricSimilarity(*earlier, *fingerprint), 0.0, 1.0));
+    compared_ += static_cast<std::int64_t>(n);
+    d = detector_.add(row_, continues);
+  } else {
+    double mean = 0.0, spread = 0.0;
+    compareSparse(*fingerprint, mean, spread);
+    d = detector_.addSparse(row_, mean, spread, continues);
+  }
+  if (indexed) {
+    if (index_ == nullptr) index_ = std::make_unique<PlaceCandidateIndex>();
+    index_->add(static_cast<int>(n), *fingerprint);
+  }
   KeyframeDetection record{frame, -1};
   FrameRevisit revisit;
   if (d.keyframe >= 0 && d.score >= config_.min_score && d.relative >= config_.min_relative) {
@@ -175,6 +236,35 @@ FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
   last_keyframe_ = frame;
   last_keyframe_revisit_ = revisit;
   return revisit;
+}
+
+void PlaceSequenceEvidence::compareSparse(const Fingerprint& fingerprint, double& mean, double& spread) {
+  const std::size_t n = keyframe_fingerprints_.size();
+  row_.assign(n, std::numeric_limits<double>::quiet_NaN());
+  const auto compare = [&](std::size_t g) {
+    if (g >= n || !std::isnan(row_[g])) return;
+    row_[g] = std::clamp(similarity_.symmetricSimilarity(*keyframe_fingerprints_[g], fingerprint), 0.0, 1.0);
+    ++compared_;
+  };
+  // The relative similarity's mean and spread from keyframes spread evenly over the whole history (the
+  // candidates below are the most similar ones: they would bias both).
+  const std::size_t m = std::min(n, static_cast<std::size_t>(config_.statistics_sample));
+  double sum = 0.0, squares = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t g = (i * n + n / 2) / m;  // evenly spaced, the same for every keyframe of a size
+    compare(g);
+    sum += row_[g];
+    squares += row_[g] * row_[g];
+  }
+  mean = m > 0 ? sum / static_cast<double>(m) : 0.0;
+  spread = m > 0 ? std::sqrt(std::max(0.0, squares / static_cast<double>(m) - mean * mean)) : 0.0;
+  // Where the robot may be back: the index's candidates (and their neighbours, for the alignment), and
+  // every live diagonal's next step.
+  for (const int g : index_->candidates(fingerprint, config_.candidates)) {
+    const auto at = static_cast<std::size_t>(g);
+    for (std::size_t a = at > 0 ? at - 1 : 0; a <= at + 1; ++a) compare(a);
+  }
+  for (const std::size_t g : detector_.continuations(static_cast<std::size_t>(config_.diagonals))) compare(g);
 }
 
 std::int64_t PlaceSequenceEvidence::placeOfFrame(std::int64_t frame) const {

@@ -221,7 +221,13 @@ SCENARIO("GIVEN preset: thesis WHEN the config is read THEN every stage takes th
   CHECK(c.topology.new_node_entropy);
   CHECK_FALSE(c.segmentation.doorway_borders);
   CHECK(c.segmentation.doorway_shift_s == 0.0);
+  CHECK_FALSE(c.sequence_evidence.frame_revisits);  // no per-frame answer: not in the thesis
+  CHECK(c.sequence_evidence.weight == 0.0);
   const DaemonConfig d = parseDaemonConfig("source: \"sim:office\"\n");
+  CHECK(d.sequence_evidence.frame_revisits);
+  CHECK(d.sequence_evidence.memory_s == 40.0);
+  CHECK(d.sequence_evidence.loop.scales == 3);
+  CHECK(d.sequence_evidence.min_score == 2.0);
   CHECK(d.preset == "default");
   CHECK(d.topology.likelihood == LikelihoodModel::Relative);
   CHECK(d.segmentation.window_s == 6.0);

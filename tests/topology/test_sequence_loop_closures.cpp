@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "binary_fingerprints.hpp"
 #include "fake_similarity.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
 
@@ -294,4 +295,48 @@ TEST_CASE("place sequence evidence: bad settings and input are refused", "[seque
   CHECK_THROWS_AS(evidence.closePlace(3, 2), std::invalid_argument);
   evidence.closePlace(0, 5);
   CHECK_THROWS_WITH(evidence.closePlace(5, 9), Contains("overlaps"));
+}
+
+TEST_CASE("sequence loop closures: beyond exhaustive_up_to a keyframe costs a bounded number of comparisons and the "
+          "second lap is still found", "[sequence_loops][large]") {
+  // Two laps of 150 keyframes (1 Hz), each tag's keyframe with its own binary descriptors (seen again with 20
+  // of 256 bits changed), so the candidate index finds the twin; the lap similarity scores the pairs.
+  const int lap = 150;
+  const test::TagSimilarity similarity = lapSimilarity();
+  const auto run = [&](int exhaustive_up_to) {
+    SequenceEvidenceConfig config;
+    config.exhaustive_up_to = exhaustive_up_to;
+    config.candidates = 8;
+    config.diagonals = 8;
+    config.statistics_sample = 32;
+    PlaceSequenceEvidence detector(config, similarity);
+    std::vector<FrameRevisit> answers;
+    std::vector<std::int64_t> cost;  // comparisons of each keyframe
+    for (int k = 0; k < 2 * lap; ++k) {
+      const int tag = k % lap;
+      const std::int64_t before = detector.comparisons();
+      answers.push_back(detector.addFrame(k, static_cast<double>(k),
+                                          test::fingerprintWith(tag, test::withNoise(test::placeDescriptors(tag, 40), 20,
+                                                                                     static_cast<std::uint64_t>(k)))));
+      cost.push_back(detector.comparisons() - before);
+    }
+    return std::make_pair(answers, cost);
+  };
+  const auto [exact, exact_cost] = run(1000000);
+  const auto [sparse, sparse_cost] = run(30);
+  int exact_right = 0, sparse_right = 0, sparse_wrong = 0;
+  for (int k = lap; k < 2 * lap; ++k) {
+    exact_right += exact[static_cast<std::size_t>(k)].match_frame == k - lap ? 1 : 0;
+    const std::int64_t m = sparse[static_cast<std::size_t>(k)].match_frame;
+    sparse_right += m == k - lap ? 1 : 0;
+    sparse_wrong += m >= 0 && m != k - lap ? 1 : 0;
+  }
+  CHECK(exact_right >= lap - 10);
+  CHECK(sparse_right >= exact_right - 5);
+  CHECK(sparse_wrong <= 2);
+  // Exhaustive: one comparison per earlier keyframe. Beyond 30 keyframes: at most the sample, the candidates
+  // and their neighbours, and three keyframes for each of the 8 diagonals of each of the 3 memories.
+  CHECK(exact_cost.back() == 2 * lap - 1);
+  for (int k = 31; k < 2 * lap; ++k) CHECK(sparse_cost[static_cast<std::size_t>(k)] <= 32 + 3 * 8 + 3 * 3 * 8);
+  CHECK(sparse_cost[30] == 30);  // up to exhaustive_up_to keyframes, every earlier one
 }

@@ -31,6 +31,7 @@
 
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
+#include "toposlam/topology/place_candidate_index.hpp"
 
 namespace toposlam {
 
@@ -69,6 +70,14 @@ class SequenceLoopDetector {
   /// continues_previous = false: the new keyframe starts a traversal (no diagonal runs from the previous
   /// keyframe into it, nor from the keyframe before it into it later on).
   Detection add(const std::vector<double>& similarities, bool continues_previous = true);
+  /// The same with only some similarities known (NaN: not compared; its z counts as 0, the mean) and the
+  /// relative similarity's mean and spread given (measured on a sample of the earlier keyframes): the cost
+  /// of a keyframe then no longer grows with the keyframes compared (PlaceSequenceEvidence, large maps).
+  Detection addSparse(const std::vector<double>& similarities, double mean, double spread, bool continues_previous);
+  /// The earlier keyframes whose similarity the next keyframe's live diagonals need: for each memory, the
+  /// `per_memory` diagonals with the largest positive D now, each continued one keyframe on (g + 1) with
+  /// its neighbours for the alignment. Sorted, no repeats.
+  std::vector<std::size_t> continuations(std::size_t per_memory) const;
 
   std::int64_t keyframes() const { return static_cast<std::int64_t>(starts_run_.size()); }
 
@@ -77,6 +86,7 @@ class SequenceLoopDetector {
   std::vector<std::vector<double>> integrated_;  ///< per memory: D_k(latest keyframe, g) for g < latest
   std::vector<double> next_;                     ///< scratch, reused
   std::vector<double> z_;                        ///< scratch: this keyframe's relative similarities
+  Detection integrate(const std::vector<double>& similarities, bool continues_previous);
   std::vector<bool> starts_run_;    ///< per keyframe: the first of its traversal
 };
 
@@ -100,6 +110,14 @@ struct SequenceEvidenceConfig {
   double weight = 0.0;
   /// The keyframe's own relative similarity z with the detected keyframe needed to count: a run's evidence
   /// fades slowly after the revisit ends, and without this the diagonal it leaves behind keeps voting.
+  /// Large maps: up to this many keyframes every earlier keyframe is compared (exact); beyond, only the
+  /// keyframes the candidate index finds (`candidates`), the live diagonals' continuations (`diagonals` per
+  /// memory) and a fixed `statistics_sample` for the mean and spread: a bounded cost per keyframe.
+  /// Fingerprints without binary descriptors (SIFT) are always compared exhaustively.
+  int exhaustive_up_to = 1000;
+  int candidates = 32;
+  int diagonals = 32;
+  int statistics_sample = 128;
   /// -1e6 (the default): no such test; measured, it cost the real samples a right frame and the corridor two
   /// (docs/topology.md, "The per-frame answer").
   double min_relative = -1e6;
@@ -145,14 +163,21 @@ class PlaceSequenceEvidence {
   std::vector<double> closePlace(std::int64_t first_frame, std::int64_t last_frame);
 
   std::int64_t keyframes() const { return detector_.keyframes(); }
+  /// Similarities computed so far (the cost: exhaustive, one per earlier keyframe per keyframe; bounded
+  /// beyond exhaustive_up_to).
+  std::int64_t comparisons() const { return compared_; }
 
  private:
+  /// row_ := the new keyframe's similarities (NaN where not compared); mean and spread for addSparse.
+  void compareSparse(const Fingerprint& fingerprint, double& mean, double& spread);
   /// Index of the kept place holding `frame`, -1 if none.
   std::int64_t placeOfFrame(std::int64_t frame) const;
 
   SequenceEvidenceConfig config_;
   const SimilarityMeasure& similarity_;
   SequenceLoopDetector detector_;
+  std::unique_ptr<PlaceCandidateIndex> index_;  ///< the keyframes' descriptors (large maps)
+  std::int64_t compared_ = 0;                   ///< similarities computed so far
   std::vector<std::shared_ptr<const Fingerprint>> keyframe_fingerprints_;
   std::vector<std::int64_t> keyframe_frames_;
   double last_keyframe_time_s_ = 0.0;
