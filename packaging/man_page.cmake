@@ -7,6 +7,10 @@ get_filename_component(_program_name "${PROGRAM}" NAME)
 string(REGEX REPLACE "\\.gz$" "" _page "${OUT}")
 set(_include "${_page}.include")
 set(_include_option)
+# The output folder: Ninja makes it for a command's OUTPUT, the Makefile generator does not (issue 38: a
+# page without SUBCOMMANDS that ran first had no folder to write to).
+get_filename_component(_folder "${OUT}" DIRECTORY)
+file(MAKE_DIRECTORY "${_folder}")
 
 if(SUBCOMMANDS)
   execute_process(COMMAND "${PROGRAM}" --help OUTPUT_VARIABLE _help RESULT_VARIABLE _rc)

@@ -73,7 +73,12 @@ struct JpegError {
   std::longjmp(error->jump, 1);
 }
 
-void jpegQuiet(j_common_ptr) {}  // warnings ("Corrupt JPEG data: ...") are not printed; the image decodes
+// Warnings ("Corrupt JPEG data: ...", "Premature end of JPEG file") are not printed but kept: libjpeg
+// decodes such an image with made-up pixels, so decodeJpeg refuses it (issue 41).
+void jpegQuiet(j_common_ptr info) {
+  auto* error = reinterpret_cast<JpegError*>(info->err);
+  if (info->err->num_warnings == 0) info->err->format_message(info, error->message);  // the first one
+}
 
 /// Everything a decompression needs, created once, destroyed by the destructor (outside any setjmp).
 struct JpegDecoder {
@@ -158,6 +163,8 @@ cv::Mat decodeJpeg(const unsigned char* data, std::size_t size, ImageColor color
   const int orientation = exifOrientation(d.info);  // before the pixels: finishing frees the saved markers
   cv::Mat image(static_cast<int>(d.info.image_height), static_cast<int>(d.info.image_width), bgr ? CV_8UC3 : CV_8UC1);
   if (!jpegReadPixels(d, image.data, image.step)) throw ImageCodecError(d.error.message);
+  if (d.info.err->num_warnings > 0)
+    throw ImageCodecError(std::string("corrupt JPEG data (") + d.error.message + ")");
   applyOrientation(image, orientation);
   return image;
 }

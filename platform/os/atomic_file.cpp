@@ -35,7 +35,7 @@ int AtomicFileWrite::create() {
   const std::string pattern = (folder_ / name).string();
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
-  fd_ = ::mkstemp(buffer.data());
+  fd_ = ::mkostemp(buffer.data(), O_CLOEXEC);  // O_EXCL too: never an existing file, nor a link
   if (fd_ < 0) return errno;
   temporary_ = buffer.data();
   ::fchmod(fd_, 0644);  // mkstemp creates 0600; what we write is not secret (best effort)

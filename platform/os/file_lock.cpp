@@ -15,7 +15,9 @@ namespace toposlam {
 std::optional<FileLock> FileLock::tryAcquire(const std::filesystem::path& lock_file,
                                              FileLockFailure& failure) {
   std::filesystem::path locked = lock_file;
-  int fd = ::open(locked.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // O_NOFOLLOW: a lock file that is a symbolic link is refused (ELOOP), never followed, so a link planted
+  // beside a map cannot make us write our process id into the file it points to (issue 41).
+  int fd = ::open(locked.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd < 0 && (errno == EROFS || errno == EACCES || errno == EPERM)) {
     locked = lock_file.has_parent_path() ? lock_file.parent_path() : std::filesystem::path(".");
     fd = ::open(locked.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -36,9 +38,10 @@ std::optional<FileLock> FileLock::tryAcquire(const std::filesystem::path& lock_f
     ::close(fd);
     return std::nullopt;
   }
-  // Record our process id for the message a second process prints (best effort).
+  // Record our process id for the message a second process prints (best effort), only in a regular file
+  // of one name: a hard link to another file is locked but never truncated.
   struct stat st {};
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_nlink == 1) {
     const std::string pid = std::to_string(::getpid()) + "\n";
     if (::ftruncate(fd, 0) == 0 && ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
       // ignored: the lock itself is what matters

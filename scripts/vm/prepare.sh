@@ -28,6 +28,19 @@ fi
 
 log() { echo "vm-prepare: $*" >&2; }
 
+# The tools it needs, each named with the package that brings it (scripts/setup.sh --test installs them all):
+# without one, exit 77 (ctest: skipped) and say what to install, rather than fail half-way.
+missing=""
+for need in qemu-system-x86_64:qemu-system-x86 depmod:kmod modprobe:kmod xz:xz-utils dpkg-deb:dpkg make:make \
+            gcc:gcc apt-get:apt apt-cache:apt cpio:cpio; do
+  tool=${need%%:*} package=${need#*:}
+  command -v "$tool" >/dev/null 2>&1 || [ -x "/sbin/$tool" ] || [ -x "/usr/sbin/$tool" ] || missing="$missing $tool ($package)"
+done
+if [ -n "$missing" ]; then
+  echo "vm-prepare: skipped: missing$missing; install them with scripts/setup.sh --test" >&2
+  exit 77
+fi
+
 kpkg=$(apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-/{print $2; exit}')
 [ -n "$kpkg" ] || { log "cannot find the kernel package linux-image-amd64 depends on (apt-get update?)"; exit 1; }
 kver=${kpkg#linux-image-}

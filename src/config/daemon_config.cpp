@@ -11,6 +11,8 @@
 #include <sstream>
 #include <vector>
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 #include <yaml-cpp/yaml.h>
 
 namespace toposlam {
@@ -36,6 +38,15 @@ ConfigValue valueOf(const ConfigKey& key, const YAML::Node& node) {
   const std::string& path = key.path;
   switch (key.kind) {
     case ConfigKind::Integer:
+      // YAML 1.1 (yaml-cpp) reads 010 as octal 8, YAML 1.2 as decimal 10: neither is said, so refused.
+      if (node.IsScalar()) {
+        const std::string& text = node.Scalar();
+        const std::size_t digits = text.find_first_not_of("+-");
+        if (digits != std::string::npos && text.size() > digits + 1 && text[digits] == '0' &&
+            text.find_first_not_of("0123456789", digits) == std::string::npos)
+          throw ConfigError(path + ": '" + text + "' has a leading zero (read as octal by some YAML readers, as "
+                            "decimal by others); write it without");
+      }
       try {
         return node.as<long long>();
       } catch (const YAML::Exception&) {
@@ -164,6 +175,31 @@ int yamlDocumentCount(const std::string& text) {
   return documents;
 }
 
+// Aliases (*name) are refused before the document is built: a config needs none, and yaml-cpp expands
+// them into shared nodes that a walk over the tree visits once per path, so a 1 KB "billion laughs" file
+// took minutes (issue 41). yaml-cpp's event parser reports each alias without expanding anything.
+class AliasRefuser final : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
+    throw ConfigError("line " + std::to_string(mark.line + 1) + ": aliases (*name) are not allowed; write the value out");
+  }
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+void refuseAliases(const std::string& yaml_text) {
+  std::istringstream in(yaml_text);
+  YAML::Parser parser(in);
+  AliasRefuser refuser;
+  parser.HandleNextDocument(refuser);
+}
+
 // yaml-cpp keeps both entries of a repeated key and look-ups see only the first, so the second would be
 // ignored silently: refused, naming the key and its line.
 void refuseDuplicateKeys(const YAML::Node& node, const std::string& path) {
@@ -233,9 +269,12 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
     if (const int documents = yamlDocumentCount(yaml_text); documents > 1)
       throw ConfigError(origin + ": holds " + std::to_string(documents) +
                         " YAML documents (a '---' line starts another); toposlamd reads exactly one");
+    refuseAliases(yaml_text);
     root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(origin + ": not valid YAML: " + e.what());
+  } catch (const ConfigError& e) {
+    throw ConfigError(origin + ": " + e.what());
   }
   try {
     refuseDuplicateKeys(root, "");

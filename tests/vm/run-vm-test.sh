@@ -2,7 +2,8 @@
 # The VM test (ctest label `vm`): boots Debian's own kernel under QEMU (TCG, no KVM needed), with
 # v4l2loopback, vivid and vimc loaded, shares this machine's root read-only over 9p and runs the real
 # toposlam binaries from BUILD_DIR inside (tests/vm/guest.sh). Passes when every guest check passed.
-# Exit 77 (skipped) only when QEMU cannot run here at all (no qemu-system-x86_64).
+# Exit 77 (skipped) when QEMU or a tool the guest is built with is missing here (each named with its
+# package).
 # Time: no fixed budget. tests/vm/watch-guest.sh follows the guest: the boot must come within 120 s, and
 # each guest step within its own limit for an idle machine times the slowness the guest's boot measured
 # (tests/vm/budget.sh), so a busy machine stretches the limits and a hang still fails, naming its step.
@@ -24,9 +25,10 @@ if [ -z "$qemu" ]; then
   echo "vm-test: SKIPPED: qemu-system-x86_64 is not installed (scripts/setup.sh installs qemu-system-x86)"
   exit 77
 fi
-for tool in busybox cpio modprobe depmod dpkg-deb make gcc xz; do
-  command -v "$tool" >/dev/null || [ -x "/bin/$tool" ] || [ -x "/sbin/$tool" ] ||
-    { echo "vm-test: FAILED: $tool missing (run scripts/setup.sh)"; exit 1; }
+for need in busybox:busybox-static cpio:cpio modprobe:kmod depmod:kmod dpkg-deb:dpkg make:make gcc:gcc xz:xz-utils; do
+  tool=${need%%:*}
+  command -v "$tool" >/dev/null || [ -x "/bin/$tool" ] || [ -x "/sbin/$tool" ] || [ -x "/usr/sbin/$tool" ] ||
+    { echo "vm-test: SKIPPED: $tool is not installed (package ${need#*:}; scripts/setup.sh --test installs it)"; exit 77; }
 done
 [ -x "$build/src/apps/toposlam/toposlam" ] || { echo "vm-test: FAILED: build toposlam in $build first"; exit 1; }
 

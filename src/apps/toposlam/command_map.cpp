@@ -68,6 +68,7 @@ struct MapOptions {
   MotionOptions motion;
   std::string frame_loops = "sequence";  ///< frame-level loop closures: sequence (default) or visits
   bool json = false;                     ///< --json: the summary as one JSON object on stdout
+  bool quiet = false;                    ///< --quiet: no progress and no per-place lines on stderr
   CLI::Option* frame_loops_given = nullptr;
   int loop_min_gap = 10;  ///< visits: detections at least this many frames back
   /// The sequence detector and its evidence (--loop-*, --keyframe-interval-s, --sequence-evidence*); the
@@ -277,6 +278,7 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
     if (!done.timing.empty()) done.timing.back().filter_ms = *done.timing.back().filter_ms + msSince(start);
     origins.push_back(ObservationOrigin{run_number, place.representative_frame});
     const TopologyEstimate& e = mapped.estimate;
+    if (o.quiet) return;
     std::fprintf(stderr,
                  "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
                  static_cast<long long>(place.index), static_cast<long long>(place.first_frame),
@@ -286,12 +288,12 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
 
   for (const std::string& uri : o.sources) {
     std::unique_ptr<FrameSource> source = openSource(uri);
-    std::cerr << "map: " << source->describe() << "\n";
+    if (!o.quiet) std::cerr << "map: " << source->describe() << "\n";
     runner.beginTraversal();  // fresh segmentation window per traversal
     // Each traversal has its own clock, with any step back inside it cut out (the segmentation stage's;
     // docs/reliability.md, "Clock jumps"); the next source starts its own, so where it goes back a new
     // traversal begins (frames.csv).
-    Progress source_progress("map", "frames", source->frameCountHint());
+    Progress source_progress("map", "frames", source->frameCountHint(), o.quiet);
     progress = &source_progress;
     std::int64_t read = 0;
     while (std::optional<Frame> frame = source->next()) {
@@ -648,6 +650,7 @@ void addMapCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--out", options->out, "Output run folder")->required();
   cmd->add_flag("--json", options->json, "Print the summary as one JSON object (frames, places, nodes, probabilities)");
+  cmd->add_flag("--quiet", options->quiet, "No progress and no per-place lines on stderr (warnings and errors stay)");
   auto* particles = cmd->add_option("--particles", options->particles, "Particles (thesis: 500)")
                         ->check(keyRange("topology.particles"))
                         ->capture_default_str();

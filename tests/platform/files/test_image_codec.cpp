@@ -3,6 +3,8 @@
 // same JPEG bytes from the same image and quality, and clear errors for what it does not read.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -209,8 +211,20 @@ TEST_CASE("GIVEN bytes the codec does not read WHEN decoded THEN the error says 
                     Catch::Contains("not a JPEG, PNG, BMP or PNM image"));
   auto jpeg = readBytes(kSamples + "/1.jpg");
   CHECK_THROWS_WITH(decodeImage(jpeg.data(), jpeg.size(), ImageColor::Bgr, 1000), Catch::Contains("512x384 pixels is over the cap"));
-  jpeg[jpeg.size() / 2] ^= 0xFF;  // damaged scan data: libjpeg warns and decodes; never a crash
-  CHECK_NOTHROW(decode(jpeg, ImageColor::Bgr));
+  // Damaged scan data: libjpeg warns and would decode made-up pixels; refused instead (issue 41).
+  auto overwritten = jpeg;
+  std::fill(overwritten.begin() + static_cast<std::ptrdiff_t>(jpeg.size() / 2),
+            overwritten.begin() + static_cast<std::ptrdiff_t>(jpeg.size() / 2 + 300), 0x55);
+  CHECK_THROWS_WITH(decode(overwritten, ImageColor::Bgr), Catch::Contains("corrupt JPEG data ("));
+  std::vector<unsigned char> halved(jpeg.begin(), jpeg.begin() + static_cast<std::ptrdiff_t>(jpeg.size() / 2));
+  halved.push_back(0xFF);
+  halved.push_back(0xD9);  // an end marker after half the scan
+  CHECK_THROWS_WITH(decode(halved, ImageColor::Bgr), Catch::Contains("corrupt JPEG data ("));
+  jpeg[jpeg.size() / 2] ^= 0xFF;  // one flipped byte: refused or decoded, never a crash
+  try {
+    decode(jpeg, ImageColor::Bgr);
+  } catch (const ImageCodecError&) {
+  }
   auto png = encodeImage(testPicture(20, 20, CV_8UC3), ImageFormat::Png);
   png[40] ^= 0xFF;  // inside the image data chunk: a CRC error from libpng
   CHECK_THROWS_AS(decode(png, ImageColor::Bgr), ImageCodecError);

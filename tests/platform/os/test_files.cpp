@@ -96,6 +96,27 @@ SCENARIO(
   fs::remove_all(dir);
 }
 
+SCENARIO("GIVEN a lock file that is a symbolic link or a hard link to another file WHEN locked THEN the other "
+         "file is never written") {
+  const TempFolder temp("lock-links");
+  const fs::path& dir = temp.path;
+  { std::ofstream(dir / "victim") << "keep me"; }
+  fs::create_symlink(dir / "victim", dir / "map.tsm.lock");
+  FileLockFailure failure;
+  CHECK_FALSE(FileLock::tryAcquire(dir / "map.tsm.lock", failure));
+  CHECK(failure.cannot_open);
+  CHECK(failure.error == ELOOP);
+  CHECK(readAll(dir / "victim") == "keep me");
+  fs::remove(dir / "map.tsm.lock");
+  fs::create_hard_link(dir / "victim", dir / "map.tsm.lock");
+  {
+    std::optional<FileLock> lock = FileLock::tryAcquire(dir / "map.tsm.lock", failure);
+    CHECK(lock);  // locked, but not truncated nor written
+  }
+  CHECK(readAll(dir / "victim") == "keep me");
+  fs::remove_all(dir);
+}
+
 SCENARIO(
     "GIVEN files and folders WHEN read, linked, renamed and removed THEN each says what the system said") {
   const TempFolder temp("calls");
