@@ -184,13 +184,14 @@ class AliasRefuser final : public YAML::EventHandler {
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
-    throw ConfigError("line " + std::to_string(mark.line + 1) + ": aliases (*name) are not allowed; write the value out");
+    if (first_alias_line < 0) first_alias_line = mark.line + 1;  // noted, not thrown through yaml-cpp
   }
   void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
   void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
   void OnSequenceEnd() override {}
   void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
   void OnMapEnd() override {}
+  int first_alias_line = -1;
 };
 
 void refuseAliases(const std::string& yaml_text) {
@@ -198,6 +199,9 @@ void refuseAliases(const std::string& yaml_text) {
   YAML::Parser parser(in);
   AliasRefuser refuser;
   parser.HandleNextDocument(refuser);
+  if (refuser.first_alias_line > 0)
+    throw ConfigError("line " + std::to_string(refuser.first_alias_line) +
+                      ": aliases (*name) are not allowed; write the value out");
 }
 
 // yaml-cpp keeps both entries of a repeated key and look-ups see only the first, so the second would be
