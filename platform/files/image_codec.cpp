@@ -65,6 +65,7 @@ struct JpegError {
   jpeg_error_mgr manager;  // first: libjpeg's callbacks get a pointer to it
   std::jmp_buf jump;
   char message[JMSG_LENGTH_MAX];
+  bool corrupt = false;  ///< a warning that the pixels are made up (decodeJpeg refuses the image)
 };
 
 [[noreturn]] void jpegErrorExit(j_common_ptr info) {
@@ -73,11 +74,19 @@ struct JpegError {
   std::longjmp(error->jump, 1);
 }
 
-// Warnings ("Corrupt JPEG data: ...", "Premature end of JPEG file") are not printed but kept: libjpeg
-// decodes such an image with made-up pixels, so decodeJpeg refuses it (issue 41).
-void jpegQuiet(j_common_ptr info) {
+void jpegQuiet(j_common_ptr) {}  // nothing printed
+
+// Warnings ("Corrupt JPEG data: bad Huffman code", "premature end of data segment", "Premature end of
+// JPEG file") are not printed but kept: libjpeg decodes such an image with made-up pixels, so decodeJpeg
+// refuses it (issue 41). One warning is harmless and common in cameras' MJPEG: bytes of padding between
+// the scan and the next marker ("N extraneous bytes before marker"); the pixels are all there.
+void jpegWarning(j_common_ptr info, int level) {
+  if (level >= 0) return;  // trace messages
   auto* error = reinterpret_cast<JpegError*>(info->err);
-  if (info->err->num_warnings == 0) info->err->format_message(info, error->message);  // the first one
+  ++info->err->num_warnings;
+  if (info->err->msg_code == JWRN_EXTRANEOUS_DATA || error->corrupt) return;
+  error->corrupt = true;
+  info->err->format_message(info, error->message);
 }
 
 /// Everything a decompression needs, created once, destroyed by the destructor (outside any setjmp).
@@ -94,6 +103,7 @@ bool jpegReadHeader(JpegDecoder& d, const unsigned char* data, std::size_t size)
   d.info.err = jpeg_std_error(&d.error.manager);
   d.error.manager.error_exit = jpegErrorExit;
   d.error.manager.output_message = jpegQuiet;
+  d.error.manager.emit_message = jpegWarning;
   if (setjmp(d.error.jump)) return false;
   jpeg_create_decompress(&d.info);
   d.created = true;
@@ -163,8 +173,7 @@ cv::Mat decodeJpeg(const unsigned char* data, std::size_t size, ImageColor color
   const int orientation = exifOrientation(d.info);  // before the pixels: finishing frees the saved markers
   cv::Mat image(static_cast<int>(d.info.image_height), static_cast<int>(d.info.image_width), bgr ? CV_8UC3 : CV_8UC1);
   if (!jpegReadPixels(d, image.data, image.step)) throw ImageCodecError(d.error.message);
-  if (d.info.err->num_warnings > 0)
-    throw ImageCodecError(std::string("corrupt JPEG data (") + d.error.message + ")");
+  if (d.error.corrupt) throw ImageCodecError(std::string("corrupt JPEG data (") + d.error.message + ")");
   applyOrientation(image, orientation);
   return image;
 }

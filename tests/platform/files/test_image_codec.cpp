@@ -220,6 +220,13 @@ TEST_CASE("GIVEN bytes the codec does not read WHEN decoded THEN the error says 
   halved.push_back(0xFF);
   halved.push_back(0xD9);  // an end marker after half the scan
   CHECK_THROWS_WITH(decode(halved, ImageColor::Bgr), Catch::Contains("corrupt JPEG data ("));
+  // Padding between the scan and the end marker, as some cameras' MJPEG has: libjpeg warns ("extraneous
+  // bytes before marker 0xd9") but every pixel is there, so it decodes as without the padding.
+  auto padded = jpeg;
+  padded.insert(padded.end() - 2, {0x00, 0x00, 0x00, 0x00});
+  const cv::Mat unpadded = decode(jpeg, ImageColor::Bgr);
+  const cv::Mat with_padding = decode(padded, ImageColor::Bgr);
+  CHECK(cv::norm(unpadded, with_padding, cv::NORM_INF) == 0.0);
   jpeg[jpeg.size() / 2] ^= 0xFF;  // one flipped byte: refused or decoded, never a crash
   try {
     decode(jpeg, ImageColor::Bgr);
