@@ -218,10 +218,15 @@ FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
     compareSparse(*fingerprint, mean, spread);
     d = detector_.addSparse(row_, mean, spread, continues);
   }
-  if (indexed) {
-    if (index_ == nullptr) index_ = std::make_unique<PlaceCandidateIndex>();
-    index_->add(static_cast<int>(n), *fingerprint);
+  // The index is built when it is first needed, from every keyframe so far, then kept up to date: a run
+  // that stays below exhaustive_up_to keyframes never pays its memory (tables of buckets, an entry per
+  // descriptor and table).
+  if (index_ == nullptr && n + 1 > static_cast<std::size_t>(config_.exhaustive_up_to)) {
+    index_ = std::make_unique<PlaceCandidateIndex>();
+    for (std::size_t g = 0; g < n; ++g)
+      if (PlaceCandidateIndex::supports(*keyframe_fingerprints_[g])) index_->add(static_cast<int>(g), *keyframe_fingerprints_[g]);
   }
+  if (indexed && index_ != nullptr) index_->add(static_cast<int>(n), *fingerprint);
   KeyframeDetection record{frame, -1};
   FrameRevisit revisit;
   if (d.keyframe >= 0 && d.score >= config_.min_score && d.relative >= config_.min_relative) {
