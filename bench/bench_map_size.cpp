@@ -40,7 +40,6 @@
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/core/svg_plot.hpp"
-#include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/platform/process_resources.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
@@ -125,13 +124,7 @@ struct Checkpoint {
 void runMapSizeBench(const MapSizeBenchOptions& o) {
   cv::setNumThreads(1);
   const MethodPreset preset = methodPreset("default");
-  VpackExtractor extractor(preset.fingerprint);
-  std::vector<Fingerprint> donors;
-  for (const cv::Mat& frame : loadSampleFrames(o.samples, cv::Size(320, 240))) {
-    Fingerprint f = extractor.extract(frame);
-    if (f.keypointCount() >= 20) donors.push_back(std::move(f));
-  }
-  if (donors.empty()) throw std::runtime_error("bench map-size: no frame with 20 keypoints in " + o.samples);
+  const std::vector<Fingerprint> donors = donorFingerprints(o.samples, preset.fingerprint, "map-size");
   const NgramSimilarity similarity(preset.similarity);
   TopologyFilterConfig config = preset.topology;
   config.particles = o.particles;

@@ -30,7 +30,6 @@
 #include "synthetic_places.hpp"
 #include "toposlam/config/method_preset.hpp"
 #include "toposlam/core/json_writer.hpp"
-#include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/platform/process_resources.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
@@ -65,13 +64,7 @@ struct Window {
 void runRevisitBench(const RevisitBenchOptions& o) {
   cv::setNumThreads(1);
   const MethodPreset preset = methodPreset("default");
-  VpackExtractor extractor(preset.fingerprint);
-  std::vector<Fingerprint> donors;
-  for (const cv::Mat& frame : loadSampleFrames(o.samples, cv::Size(320, 240))) {
-    Fingerprint f = extractor.extract(frame);
-    if (f.keypointCount() >= 20) donors.push_back(std::move(f));
-  }
-  if (donors.empty()) throw std::runtime_error("bench revisits: no frame with 20 keypoints in " + o.samples);
+  const std::vector<Fingerprint> donors = donorFingerprints(o.samples, preset.fingerprint, "revisits");
   const NgramSimilarity similarity(preset.similarity);
   SequenceEvidenceConfig config = preset.sequence_evidence;
   if (o.exhaustive_up_to >= 0) config.exhaustive_up_to = o.exhaustive_up_to;

@@ -8,13 +8,32 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "image_input.hpp"
 #include "toposlam/fingerprint/fingerprint.hpp"
+#include "toposlam/fingerprint/vpack_extractor.hpp"
 
 namespace toposlam::cli {
+
+/// The sample frames' fingerprints (at 320x240) with at least 20 keypoints: what synthetic places are made
+/// of. Throws std::runtime_error naming `bench` when there is none.
+inline std::vector<Fingerprint> donorFingerprints(const std::string& samples, const VpackConfig& config,
+                                                  const std::string& bench) {
+  VpackExtractor extractor(config);
+  std::vector<Fingerprint> donors;
+  for (const cv::Mat& frame : loadSampleFrames(samples, cv::Size(320, 240))) {
+    Fingerprint f = extractor.extract(frame);
+    if (f.keypointCount() >= 20) donors.push_back(std::move(f));
+  }
+  if (donors.empty()) throw std::runtime_error("bench " + bench + ": no frame with 20 keypoints in " + samples);
+  return donors;
+}
 
 inline double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 

@@ -31,7 +31,6 @@ run_set() {  # name source truth
   local t0 t1
   t0=$(date +%s.%N)
   "$toposlam" map "$source" --out "$work/$name" --quiet "${extra[@]}" >"$work/$name.map.txt" 2>&1 \
-    || "$toposlam" map "$source" --out "$work/$name" "${extra[@]}" >"$work/$name.map.txt" 2>&1 \
     || { echo "real-bench: map on $name failed: $(tail -2 "$work/$name.map.txt")" >&2; exit 1; }
   t1=$(date +%s.%N)
   "$toposlam" eval "$work/$name" --truth "$truth" --json >"$work/$name.eval.json" 2>/dev/null

@@ -6,9 +6,9 @@
 
 #include <toposlam_lcm/place_event_t.hpp>
 #include <toposlam_lcm/place_t.hpp>
-#include <toposlam_lcm/place_v1_t.hpp>
 #include <toposlam_lcm/topology_t.hpp>
 
+#include "place_decode.hpp"
 #include "toposlam/platform/lcm_log.hpp"
 
 namespace toposlam {
@@ -34,24 +34,18 @@ LoggedRun readLoggedRun(const std::string& path, const LcmChannels& channels) {
     ++run.events;
     const std::string kind = channelKind(channels, event.channel);
     if (kind == "place") {
-      // A recording from before the per-frame answer holds place_v1_t: the same fields up to map_revision.
       toposlam_lcm::place_t m{};
-      LoggedFrame f;
-      if (decodeEvent(event, kind, m)) {
-        f.frame = m.frame;
-        f.time_s = static_cast<double>(m.utime) * 1e-6;
-        f.lambda2 = m.lambda2;
-        f.match_frame = m.match_frame;
-        f.match_score = m.match_score;
-        f.match_node = m.match_node;
-      } else if (toposlam_lcm::place_v1_t old{}; decodeEvent(event, "place_v1", old)) {
-        f.frame = old.frame;
-        f.time_s = static_cast<double>(old.utime) * 1e-6;
-        f.lambda2 = old.lambda2;
-      } else {
+      if (!decodePlaceMessage(event.data.data(), event.data.size(), m)) {  // old recordings too
         ++run.malformed;
         continue;
       }
+      LoggedFrame f;
+      f.frame = m.frame;
+      f.time_s = static_cast<double>(m.utime) * 1e-6;
+      f.lambda2 = m.lambda2;
+      f.match_frame = m.match_frame;
+      f.match_score = m.match_score;
+      f.match_node = m.match_node;
       if (!std::isfinite(f.lambda2)) f.lambda2 = std::numeric_limits<double>::quiet_NaN();
       run.frames.push_back(f);
     } else if (kind == "place_event") {

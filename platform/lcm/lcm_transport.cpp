@@ -17,6 +17,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
+#include "place_decode.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/io/image_codec.hpp"
 #include "toposlam_lcm/motion_t.hpp"
@@ -334,28 +335,6 @@ const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(
 const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopologyNode), length(), array(12)};
 const WireSchema kMotion = {fixed(8 * 7 + 1)};
 
-/// An old recording's place message as today's, with no per-frame match.
-toposlam_lcm::place_t placeFromV1(const toposlam_lcm::place_v1_t& old) {
-  toposlam_lcm::place_t m{};
-  m.utime = old.utime;
-  m.publish_utime = old.publish_utime;
-  m.frame = old.frame;
-  m.latency_ms = old.latency_ms;
-  m.place = old.place;
-  m.node = old.node;
-  m.probability = old.probability;
-  m.is_new = old.is_new;
-  m.lambda2 = old.lambda2;
-  m.num_alternatives = old.num_alternatives;
-  m.alternatives = old.alternatives;
-  m.map_revision = old.map_revision;
-  m.match_frame = -1;
-  m.match_score = 0.0F;
-  m.match_place = -1;
-  m.match_node = -1;
-  return m;
-}
-
 template <typename Message>
 bool decodeMessage(const void* data, std::size_t size, Message& msg, const std::string& kind) {
   if (size > static_cast<std::size_t>(std::numeric_limits<int>::max()) || !lcmArrayLengthsFit(kind, data, size))
@@ -368,6 +347,31 @@ bool decodeMessage(const void* data, std::size_t size, Message& msg, const std::
 }
 
 }  // namespace
+
+bool decodePlaceMessage(const void* data, std::size_t size, toposlam_lcm::place_t& out) {
+  if (decodeMessage(data, size, out, "place")) return true;
+  toposlam_lcm::place_v1_t old{};
+  if (!decodeMessage(data, size, old, "place_v1")) return false;
+  // An old recording's place message as today's, with no per-frame match.
+  out = toposlam_lcm::place_t{};
+  out.utime = old.utime;
+  out.publish_utime = old.publish_utime;
+  out.frame = old.frame;
+  out.latency_ms = old.latency_ms;
+  out.place = old.place;
+  out.node = old.node;
+  out.probability = old.probability;
+  out.is_new = old.is_new;
+  out.lambda2 = old.lambda2;
+  out.num_alternatives = old.num_alternatives;
+  out.alternatives = old.alternatives;
+  out.map_revision = old.map_revision;
+  out.match_frame = -1;
+  out.match_score = 0.0F;
+  out.match_place = -1;
+  out.match_node = -1;
+  return true;
+}
 
 bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size) {
   const WireSchema* schema = kind == "place"         ? &kPlace
@@ -440,15 +444,9 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
   w.beginObject().field("channel", channel).field("kind", kind);
   bool ok = true;
   if (kind == "place") {
-    // Recordings from before the per-frame answer carry place_v1_t (its fingerprint differs): read as such,
-    // with no match.
+    // Recordings from before the per-frame answer carry place_v1_t: read with no match.
     toposlam_lcm::place_t m{};
-    ok = decodeMessage(data, size, m, kind);
-    if (!ok) {
-      toposlam_lcm::place_v1_t old{};
-      ok = decodeMessage(data, size, old, "place_v1");
-      if (ok) m = placeFromV1(old);
-    }
+    ok = decodePlaceMessage(data, size, m);
     if (ok) {
       out.frame = m.frame;
       out.node = m.node;

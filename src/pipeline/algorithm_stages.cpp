@@ -192,6 +192,7 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   // an older run mean nothing in this one, so resumed observations show -1.
   representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);
   run_first_observation_ = filter_->observationCount();
+  spans_.clear();  // frame numbers of an older run mean nothing in this one
   last_mapped_frame_ = -1;  // where the source stands in it: the daemon says (setLastMappedFrame)
   last_mapped_name_.clear();
   revision_ = 1;
@@ -242,9 +243,11 @@ void ParticleFilterTopologyStage::refresh() {
   TopologySnapshot t;
   t.map_revision = revision_;
   t.particles = filter_->config().particles;
+  best_assignment_.clear();
   if (observations > 0) {
     const TopologyEstimate te = filter_->estimate(alternatives_ + 1);
     const std::vector<int>& assignment = te.best.assignment;
+    best_assignment_ = assignment;  // node of each observation, for locate()
     e.place = observations - 1;
     e.node = te.current_node;
     e.probability = te.current_node_probability;
@@ -269,10 +272,6 @@ void ParticleFilterTopologyStage::refresh() {
     }
     for (const auto& [ends, count] : edges) t.edges.push_back({ends.first, ends.second, count});
   }
-  node_of_observation_.assign(static_cast<std::size_t>(observations), -1);
-  for (const TopologyNode& n : t.nodes)
-    for (const int observation : n.places)
-      if (observation >= 0 && observation < observations) node_of_observation_[static_cast<std::size_t>(observation)] = n.id;
   estimate_ = std::move(e);
   topology_ = std::move(t);
 }
@@ -287,8 +286,8 @@ void ParticleFilterTopologyStage::locate(RevisitEstimate& r) const {
   if (it == spans_.begin() || r.match_frame > std::prev(it)->last_frame) return;
   const int observation = std::prev(it)->observation;
   r.match_place = observation;
-  if (observation >= 0 && static_cast<std::size_t>(observation) < node_of_observation_.size())
-    r.match_node = node_of_observation_[static_cast<std::size_t>(observation)];
+  if (observation >= 0 && static_cast<std::size_t>(observation) < best_assignment_.size())
+    r.match_node = best_assignment_[static_cast<std::size_t>(observation)];
 }
 
 namespace {

@@ -198,9 +198,10 @@ FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
   const bool first = keyframe_frames_.empty();
   if (!isKeyframe(first || traversal_break_, time_s, last_keyframe_time_s_, config_.loop.keyframe_interval_s)) {
     // Between keyframes: the keyframe's match, moved on by as many frames as this one lies after it.
+    const std::int64_t keyframe = keyframe_frames_.back();  // not first: there is one
     FrameRevisit shifted = last_keyframe_revisit_;
-    if (shifted.match_frame >= 0) shifted.match_frame += frame - last_keyframe_;
-    if (shifted.match_frame >= last_keyframe_) shifted = FrameRevisit{};
+    if (shifted.match_frame >= 0) shifted.match_frame += frame - keyframe;
+    if (shifted.match_frame >= keyframe) shifted = FrameRevisit{};
     return shifted;
   }
   const bool continues = !first && !traversal_break_ && time_s >= last_keyframe_time_s_;
@@ -238,7 +239,6 @@ FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
   keyframe_frames_.push_back(frame);
   last_keyframe_time_s_ = time_s;
   traversal_break_ = false;
-  last_keyframe_ = frame;
   last_keyframe_revisit_ = revisit;
   return revisit;
 }

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <unistd.h>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -213,6 +214,19 @@ TEST_CASE("GIVEN three closed places, the third like the first WHEN the topology
   REQUIRE(t.edges.size() == 2);
   CHECK((t.edges[0].from == 0 && t.edges[0].to == 1 && t.edges[0].count == 1));
   CHECK((t.edges[1].from == 1 && t.edges[1].to == 0 && t.edges[1].count == 1));
+
+  // A frame's match is named by the stepped place holding it and that place's node (place_t.match_*).
+  const auto located = [&](std::int64_t frame) {
+    RevisitEstimate r;
+    r.match_frame = frame;
+    stage.locate(r);
+    return std::make_pair(r.match_place, r.match_node);
+  };
+  CHECK(located(3) == std::make_pair(0, 0));
+  CHECK(located(19) == std::make_pair(1, 1));
+  CHECK(located(25) == std::make_pair(2, 0));  // the revisit: the first place's node
+  CHECK(located(30) == std::make_pair(-1, -1));  // after the last stepped place
+  CHECK(located(-1) == std::make_pair(-1, -1));  // no match
 }
 
 TEST_CASE("GIVEN a map of three places saved and loaded WHEN a new run's first place is stepped THEN the "
@@ -244,6 +258,14 @@ TEST_CASE("GIVEN a map of three places saved and loaded WHEN a new run's first p
   REQUIRE(t.nodes.size() == 2);
   CHECK(t.nodes[1].places == std::vector<int>{1, 3});
   CHECK(t.nodes[1].representative_frames == std::vector<std::int64_t>{-1, 4});
+  // Frames are this run's: the new place's frames name it, the older run's frames are not known.
+  RevisitEstimate r;
+  r.match_frame = 5;
+  resumed.locate(r);
+  CHECK((r.match_place == 3 && r.match_node == 1));
+  r.match_frame = 25;
+  resumed.locate(r);
+  CHECK((r.match_place == -1 && r.match_node == -1));
 }
 
 TEST_CASE("GIVEN frames with thumbnails WHEN the segmentation stage closes a place THEN it carries its "

@@ -233,7 +233,7 @@ class ParticleFilterTopologyStage final : public TopologyStage {
     int observation = -1;
   };
   std::vector<PlaceSpan> spans_;
-  std::vector<int> node_of_observation_;  ///< in the most probable topology (refresh())
+  std::vector<int> best_assignment_;  ///< node of each observation in the most probable topology (refresh())
   std::int64_t revision_ = 0;
   PlaceEstimate estimate_;
   TopologySnapshot topology_;

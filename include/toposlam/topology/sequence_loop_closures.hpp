@@ -182,8 +182,7 @@ class PlaceSequenceEvidence {
   std::vector<std::int64_t> keyframe_frames_;
   double last_keyframe_time_s_ = 0.0;
   bool traversal_break_ = true;
-  std::int64_t last_keyframe_ = -1;  ///< frame of the latest keyframe
-  FrameRevisit last_keyframe_revisit_;  ///< its answer
+  FrameRevisit last_keyframe_revisit_;  ///< the latest keyframe's answer
   struct KeyframeDetection {
     std::int64_t frame = -1;          ///< the keyframe
     std::int64_t matched_frame = -1;  ///< its detection (-1: none that counts)

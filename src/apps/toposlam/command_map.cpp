@@ -157,17 +157,11 @@ VpackConfig fingerprintConfig(const MapOptions& o, const MethodPreset& preset) {
   return vpack;
 }
 
-/// How frame-level loop closures are found (docs/topology.md): by sequence, online (the per-frame answer
-/// toposlamd publishes), or by visits to a node of the final topology.
-struct FrameLoopPlan {
-  bool by_sequence = true;
-};
-
-FrameLoopPlan frameLoopPlan(const MapOptions& o, const MethodPreset& preset) {
-  FrameLoopPlan plan;
-  // The thesis has no frame-level detector of its own: its preset reads frame closures off the topology.
-  plan.by_sequence = o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.name != "thesis";
-  return plan;
+/// How frame-level loop closures are found (docs/topology.md): true by sequence, online (the per-frame
+/// answer toposlamd publishes; SequenceEvidenceConfig::frame_revisits), false by visits to a node of the
+/// final topology. The thesis has no frame-level detector of its own: its preset reads them off the topology.
+bool framesBySequence(const MapOptions& o, const MethodPreset& preset) {
+  return o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.sequence_evidence.frame_revisits;
 }
 
 /// The preset's similarity with --histogram-weight and --histogram-gate.
@@ -259,15 +253,17 @@ SequenceEvidenceConfig sequenceEvidenceConfig(const MapOptions& o, bool by_seque
 struct Traversals {
   std::vector<TimingRow> timing;  ///< per segmented frame
   std::int64_t refused = 0;       ///< frames the extractor refused
-  /// Every segmented frame's fingerprint (run numbering), for the frame-level loop closures at the end.
+  /// Every segmented frame's fingerprint (run numbering), for the frame-level loop closures by visits at the
+  /// end; empty by sequence (each frame's answer came online).
   std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
 };
 
 /// Every source, one traversal after the other, through the runner: fingerprint, segment, and a filter step
-/// for every kept place; `origins` gets one entry per step.
+/// for every kept place; `origins` gets one entry per step; with `keep_fingerprints`, every frame's
+/// fingerprint (the frame-level closures by visits need them at the end).
 Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
                            FiedlerSegmentationStage& segmentation_stage, std::optional<MotionReplay>& motion,
-                           std::vector<ObservationOrigin>& origins, int run_number) {
+                           std::vector<ObservationOrigin>& origins, int run_number, bool keep_fingerprints) {
   Traversals done;
   Progress* progress = nullptr;  // the current source's progress line (cleared before a log line)
   auto mapPlace = [&](const SegmentedPlace& place) {
@@ -313,7 +309,7 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
       }
       t.fingerprint_ms = msSince(start);
       start = std::chrono::steady_clock::now();
-      done.frame_fingerprints.push_back(fingerprint);
+      if (keep_fingerprints) done.frame_fingerprints.push_back(fingerprint);
       // With several sources, names carry their source's folder ("ref/0001.jpg", "query/0001.jpg") so
       // they stay unique in frames.csv and pair ground truths can name either traversal.
       const std::string name = o.sources.size() > 1 ? sourceLabel(uri) + "/" + frame->name : frame->name;
@@ -338,8 +334,7 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
 /// settings.txt: what the run was made with, for the report's header (and a reader of the run folder).
 void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const MethodPreset& preset,
                       const VpackConfig& vpack, const FiedlerSegmenterConfig& segmenter_config,
-                      const TopologyFilterConfig& topo, const SequenceEvidenceConfig& evidence,
-                      const FrameLoopPlan& loops) {
+                      const TopologyFilterConfig& topo, const SequenceEvidenceConfig& evidence) {
   const auto real = [](double v) {
     std::ostringstream text;
     text << v;
@@ -360,7 +355,7 @@ void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const Method
           ? "weight " + real(evidence.weight) + ", detections scored at least " + real(evidence.min_score)
           : "off";
   const std::string frame_loops =
-      loops.by_sequence
+      evidence.frame_revisits
           ? "sequence, online, memories " + real(evidence.memory_s) + " s (" + std::to_string(evidence.loop.scales) +
                 " scales), at least " + real(evidence.min_gap_s) + " s back, score at least " + real(evidence.min_score)
           : "visits, at least " + std::to_string(o.loop_min_gap) + " frames back";
@@ -384,44 +379,41 @@ void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const Method
                           {"frame_loops", frame_loops}});
 }
 
-/// frames.csv's rows with their frame-level loop closures (docs/topology.md): each frame on a node seen on
-/// an earlier visit gets that visit's most similar frame, scored by similarity x the place's node
-/// probability at its step. Takes the frames' fingerprints (resized to the run's frames).
+/// frames.csv's rows with their frame-level loop closures (docs/topology.md): by sequence, the answer each
+/// frame got online as it arrived (what toposlamd publishes in place_t); by visits (the thesis preset),
+/// each frame on a node seen on an earlier visit gets that visit's most similar frame, scored by
+/// similarity x the place's node probability at its step (the frames' fingerprints, resized to the run's
+/// frames).
 std::vector<FrameRecord> frameRowsWithLoopClosures(
     const OfflineRunner& runner, const std::vector<std::int64_t>& place_nodes,
     std::vector<std::shared_ptr<const Fingerprint>>& frame_fingerprints, const NgramSimilarity& similarity,
-    const FrameLoopPlan& loops, int loop_min_gap) {
+    bool by_sequence, int loop_min_gap) {
   const SegmentationRun& all = runner.run();
   std::vector<FrameRecord> frame_rows = frameRows(all, place_nodes);
-  std::vector<std::int64_t> place_of_frame;
-  for (const auto& row : all.frames) place_of_frame.push_back(row.place);
   std::vector<double> place_probability(all.places.size(), 0.0);
   for (const MappedPlace& step : runner.steps()) {
     const auto p = static_cast<std::size_t>(step.place.index);
     if (p < place_probability.size()) place_probability[p] = step.estimate.current_node_probability;
   }
-  frame_fingerprints.resize(all.frames.size());
-  // By sequence: the answer every frame got online, as it arrived (what toposlamd publishes in place_t).
-  // By visits (the thesis preset): read off the final topology.
-  std::vector<FrameMatch> matches;
-  if (loops.by_sequence) {
-    for (const RevisitEstimate& r : runner.revisits()) {
-      FrameMatch m;
-      m.match_frame = r.match_frame;
-      m.score = r.score;
-      matches.push_back(m);
-    }
-  } else {
-    matches = matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
-                                         similarity, loop_min_gap);
+  std::vector<FrameMatch> visits;
+  if (!by_sequence) {
+    std::vector<std::int64_t> place_of_frame;
+    for (const auto& row : all.frames) place_of_frame.push_back(row.place);
+    frame_fingerprints.resize(all.frames.size());
+    visits = matchFramesToEarlierVisits(place_of_frame, place_nodes, place_probability, frame_fingerprints,
+                                        similarity, loop_min_gap);
   }
+  const std::vector<RevisitEstimate>& online = runner.revisits();
   for (std::size_t f = 0; f < frame_rows.size(); ++f) {
     FrameRecord& row = frame_rows[f];
     if (row.place >= 0 && static_cast<std::size_t>(row.place) < place_probability.size())
       row.node_probability = place_probability[static_cast<std::size_t>(row.place)];
-    if (f < matches.size()) {
-      row.match = matches[f].match_frame;
-      row.match_score = matches[f].score;
+    if (by_sequence && f < online.size()) {
+      row.match = online[f].match_frame;
+      row.match_score = online[f].score;
+    } else if (!by_sequence && f < visits.size()) {
+      row.match = visits[f].match_frame;
+      row.match_score = visits[f].score;
     }
   }
   return frame_rows;
@@ -583,7 +575,6 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const MethodPreset preset = presetOf(o.segmentation, "map");
   const VpackConfig vpack = fingerprintConfig(o, preset);
   VpackFingerprintStage fingerprint_stage(vpack, nullptr);  // no thumbnails: no place events offline
-  const FrameLoopPlan loops = frameLoopPlan(o, preset);
   const NgramSimilarity similarity(similarityConfig(o, preset));
 
   // The filter steps run to their end before the next frame, so the budget's clock is never read for a
@@ -595,12 +586,13 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const TopologyParticleFilter& filter = topology.filter();
   const int first_observation = filter.observationCount();
 
-  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, loops.by_sequence);
+  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, framesBySequence(o, preset));
   // Thumbnails are the daemon's (place events); the offline run keeps none.
   FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
   OfflineRunner runner(fingerprint_stage, segmentation_stage, &topology);
   Traversals traversals =
-      traverseSources(o, runner, segmentation_stage, motion, start.origins, start.run_number);
+      traverseSources(o, runner, segmentation_stage, motion, start.origins, start.run_number,
+                      !evidence.frame_revisits);
   if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
   const SegmentationRun& all = runner.run();
   if (all.frames.empty())
@@ -615,14 +607,14 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter.estimate(3);
   const std::vector<std::int64_t> place_nodes = runner.placeNodes();
-  writeRunSettings(out_dir, o, preset, vpack, segmenter_config, filter.config(), evidence, loops);
+  writeRunSettings(out_dir, o, preset, vpack, segmenter_config, filter.config(), evidence);
   {
     std::vector<std::string> uris;
     for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
     writeSources(out_dir, uris);
   }
   const std::vector<FrameRecord> frame_rows = frameRowsWithLoopClosures(
-      runner, place_nodes, traversals.frame_fingerprints, similarity, loops, o.loop_min_gap);
+      runner, place_nodes, traversals.frame_fingerprints, similarity, evidence.frame_revisits, o.loop_min_gap);
   traversals.frame_fingerprints.clear();
   writeFrames(out_dir, frame_rows, FrameColumns::WithLoopClosures);
   writePlaces(out_dir, placeRows(all.places, place_nodes));

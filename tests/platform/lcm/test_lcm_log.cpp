@@ -15,6 +15,7 @@
 #include "toposlam/platform/lcm_log_run.hpp"
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
+#include "toposlam_lcm/place_v1_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
 using namespace toposlam;
@@ -67,6 +68,18 @@ std::string writeSmallRun(const std::string& name) {
     p.place = f >= 4 ? 0 : -1;
     p.node = f >= 4 ? 0 : -1;
     p.lambda2 = f == 0 ? std::nanf("") : 0.5f;
+    p.match_frame = f == 5 ? 1 : -1;  // frame 5 is back at frame 1
+    p.match_score = f == 5 ? 3.5f : 0.0f;
+    p.match_place = f == 5 ? 0 : -1;
+    p.match_node = f == 5 ? 0 : -1;
+    if (f == 3) {  // as recorded before match_* existed
+      toposlam_lcm::place_v1_t old{};
+      old.utime = p.utime;
+      old.frame = p.frame;
+      old.lambda2 = p.lambda2;
+      writer.write(5'000'000 + f, "TOPOSLAM_PLACE", encode(old).data(), encode(old).size());
+      continue;
+    }
     writer.write(5'000'000 + f, "TOPOSLAM_PLACE", encode(p).data(), encode(p).size());
     if (f == 4) {
       toposlam_lcm::place_event_t e{};
@@ -161,6 +174,9 @@ TEST_CASE("GIVEN a log of a toposlamd run WHEN read as a LoggedRun THEN frames, 
   CHECK(run.frames[5].time_s == Approx(2.25));
   CHECK(std::isnan(run.frames[0].lambda2));
   CHECK(run.frames[1].lambda2 == Approx(0.5));
+  CHECK((run.frames[3].frame == 3 && run.frames[3].time_s == Approx(1.75)));  // the old message
+  CHECK(run.frames[3].match_frame == -1);
+  CHECK((run.frames[5].match_frame == 1 && run.frames[5].match_score == Approx(3.5) && run.frames[5].match_node == 0));
   REQUIRE(run.places.size() == 1);
   CHECK(run.places[0].representative_frame == 2);
   CHECK(run.places[0].keypoints == 42);
