@@ -5,8 +5,12 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:-$root/build}"
 shift || true
+# The generator: CMAKE_GENERATOR if set (CI builds its Release tree with "Unix Makefiles", so both
+# generators stay proven), else the one a configured tree already has, else Ninja when present.
 generator=()
-command -v ninja >/dev/null && generator=(-G Ninja)
+if [ -z "${CMAKE_GENERATOR:-}" ] && [ ! -f "$build/CMakeCache.txt" ] && command -v ninja >/dev/null; then
+  generator=(-G Ninja)
+fi
 # ccache (a build package of scripts/setup.sh) when present: a rebuild, another clone or the sanitizer
 # builds of CI reuse what was compiled before. Paths under the checkout are hashed relative to it.
 launcher=()

@@ -489,6 +489,11 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("topology.sequence_evidence.min_score", AT(sequence_evidence.min_score), 2.0, 0, 1e6, "",
                    "detection score (its noise's standard deviations) a frame's match needs to be published, and a "
                    "keyframe's evidence to count"));
+  k.push_back(real("topology.sequence_evidence.min_margin", AT(sequence_evidence.min_margin), 0.5, 0, 1e6, "",
+                   "how far (its noise's standard deviations) a published match's run must stand out from every other "
+                   "run: a building that repeats gives several runs alike (places published as one count as one)"));
+  k.push_back(real("topology.sequence_evidence.distinct_s", AT(sequence_evidence.distinct_s), 5.0, 0, 1e6, "s",
+                   "runs ending within this long of the best one are its own, not a runner-up"));
   k.push_back(real("topology.sequence_evidence.min_relative", AT(sequence_evidence.min_relative), -1e6, -1e6, 1e6, "",
                    "the keyframe's own relative similarity z with its match needed as well; -1e6: no such test"));
   k.push_back(real("topology.sequence_evidence.keyframe_interval_s", AT(sequence_evidence.loop.keyframe_interval_s), 1.0,

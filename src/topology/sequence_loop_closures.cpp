@@ -108,6 +108,7 @@ SequenceLoopDetector::Detection SequenceLoopDetector::integrate(const std::vecto
   // g-1 -> g are steps of one traversal (g = 0 and the first keyframe of a traversal start a diagonal).
   Detection best;
   const auto gap = static_cast<std::size_t>(config_.min_gap_keyframes);
+  score_.assign(n, 0.0);
   for (std::size_t k = 0; k < integrated_.size(); ++k) {
     const double d = config_.decayOf(static_cast<int>(k));
     const double noise = std::sqrt((1.0 - d) / (1.0 + d));
@@ -121,6 +122,7 @@ SequenceLoopDetector::Detection SequenceLoopDetector::integrate(const std::vecto
     if (n >= gap) {
       for (std::size_t g = 0; g + gap <= n; ++g) {
         const double score = next_[g] / noise;
+        if (next_[g] > 0.0) score_[g] = std::max(score_[g], score);
         if (next_[g] > 0.0 && (best.diagonal < 0 || score > best.score)) {
           best.diagonal = static_cast<std::int64_t>(g);
           best.score = score;
@@ -129,6 +131,7 @@ SequenceLoopDetector::Detection SequenceLoopDetector::integrate(const std::vecto
     }
     integrated.swap(next_);
   }
+
   if (best.diagonal >= 0) {
     // Alignment: the most similar keyframe around the diagonal's end (first of equals), never too recent.
     const auto end = static_cast<std::size_t>(best.diagonal);
@@ -140,15 +143,32 @@ SequenceLoopDetector::Detection SequenceLoopDetector::integrate(const std::vecto
       if (!std::isnan(similarities[g]) && (std::isnan(similarities[at]) || similarities[g] > similarities[at])) at = g;
     best.keyframe = static_cast<std::int64_t>(at);
     best.relative = z_[end];  // the diagonal's own (the best of a few neighbours would stand out by chance)
+    // The runner-up: the best run ending away from this one and from every keyframe of its place.
+    const std::int64_t distinct = config_.distinct_keyframes;
+    const auto own = static_cast<std::int64_t>(end);
+    for (std::size_t g = 0; g + gap <= n; ++g) {
+      const auto other = static_cast<std::int64_t>(g);
+      if (std::abs(other - own) > distinct && std::abs(place_[g] - place_[end]) > distinct)
+        best.runner_up = std::max(best.runner_up, score_[g]);
+    }
   }
   starts_run_.push_back(n == 0 || !continues_previous);
+  place_.push_back(static_cast<std::int64_t>(n));
   return best;
+}
+
+void SequenceLoopDetector::link(std::int64_t earlier) {
+  if (place_.empty() || earlier < 0 || earlier + 1 >= static_cast<std::int64_t>(place_.size()))
+    throw std::invalid_argument("SequenceLoopDetector::link: keyframe " + std::to_string(earlier) +
+                                " is not earlier than the latest");
+  place_.back() = place_[static_cast<std::size_t>(earlier)];
 }
 
 SequenceLoopConfig SequenceEvidenceConfig::loopConfig() const {
   SequenceLoopConfig c = loop;
   c.decay = 1.0 - loop.keyframe_interval_s / memory_s;
   c.min_gap_keyframes = static_cast<int>(std::ceil(min_gap_s / loop.keyframe_interval_s - 1e-9));
+  c.distinct_keyframes = static_cast<int>(std::ceil(distinct_s / loop.keyframe_interval_s - 1e-9));
   return c;
 }
 
@@ -230,9 +250,11 @@ FrameRevisit PlaceSequenceEvidence::addFrame(std::int64_t frame, double time_s,
   if (indexed && index_ != nullptr) index_->add(static_cast<int>(n), *fingerprint);
   KeyframeDetection record{frame, -1};
   FrameRevisit revisit;
-  if (d.keyframe >= 0 && d.score >= config_.min_score && d.relative >= config_.min_relative) {
+  if (d.keyframe >= 0 && d.score >= config_.min_score && d.score - d.runner_up >= config_.min_margin &&
+      d.relative >= config_.min_relative) {
     record.matched_frame = keyframe_frames_[static_cast<std::size_t>(d.keyframe)];
     revisit = FrameRevisit{record.matched_frame, d.score};
+    detector_.link(d.keyframe);
   }
   open_detections_.push_back(record);
   keyframe_fingerprints_.push_back(fingerprint);

@@ -340,3 +340,84 @@ TEST_CASE("sequence loop closures: beyond exhaustive_up_to a keyframe costs a bo
   for (int k = 31; k < 2 * lap; ++k) CHECK(sparse_cost[static_cast<std::size_t>(k)] <= 32 + 3 * 8 + 3 * 3 * 8);
   CHECK(sparse_cost[30] == 30);  // up to exhaustive_up_to keyframes, every earlier one
 }
+
+namespace {
+
+/// The per-frame answers of a stream of tags at 1 Hz (one keyframe a second, one clock) with the default
+/// published score and the given margin over the runner-up.
+std::vector<FrameRevisit> publishedRevisits(const std::vector<int>& tags, const SimilarityMeasure& similarity,
+                                            double min_margin) {
+  SequenceEvidenceConfig config;  // memory 40 s, 3 memories, 20 s gap, score >= 2, runs within 5 s are one
+  config.min_margin = min_margin;
+  PlaceSequenceEvidence evidence(config, similarity);
+  std::vector<FrameRevisit> out;
+  for (std::size_t f = 0; f < tags.size(); ++f)
+    out.push_back(evidence.addFrame(static_cast<std::int64_t>(f), static_cast<double>(f), test::taggedFingerprint(tags[f])));
+  return out;
+}
+
+/// Same tag 0.8, otherwise a fixed pseudo-random similarity in [0.1, 0.15); tags are compared modulo
+/// `period` (0: not at all), so a building whose stretches repeat every `period` tags looks periodic.
+test::TagSimilarity periodicSimilarity(int period) {
+  return test::TagSimilarity([period](int a, int b) {
+    if (a == b || (period > 0 && a % period == b % period)) return 0.8;
+    const auto h = static_cast<std::uint32_t>(a * 7919 + b * 104729) * 2654435761u;
+    return 0.1 + 0.05 * static_cast<double>(h >> 8) / static_cast<double>(1u << 24);
+  });
+}
+
+}  // namespace
+
+TEST_CASE("sequence loop closures: a run that does not stand out from another run is not published (min_margin)",
+          "[sequence_loops]") {
+  // A stretch of ten views seen twice in a row (the same ten doors on both halves of a corridor: too recent
+  // to match each other, 10 s < the 20 s gap), 40 s elsewhere, then the stretch again: it matches both of
+  // its earlier halves in step, equally. Where the robot is cannot be told, so nothing is published with a
+  // margin, and the detector alone publishes it.
+  std::vector<int> tags;
+  for (int half = 0; half < 2; ++half)
+    for (int i = 0; i < 10; ++i) tags.push_back(i);
+  for (int i = 0; i < 40; ++i) tags.push_back(100 + i);
+  for (int i = 0; i < 10; ++i) tags.push_back(i);
+  for (int i = 0; i < 20; ++i) tags.push_back(200 + i);
+  const test::TagSimilarity similarity = periodicSimilarity(0);
+  // Counted over the stretch's return (frames 60-69; what follows it is docs/topology.md's "after leaving").
+  const auto published = [&](const std::vector<FrameRevisit>& revisits, std::size_t from) {
+    int count = 0;
+    for (std::size_t f = from; f < from + 10; ++f) count += revisits[f].match_frame >= 0;
+    return count;
+  };
+  CHECK(published(publishedRevisits(tags, similarity, 0.0), 60) >= 8);  // from its second or third view on
+  CHECK(published(publishedRevisits(tags, similarity, 0.5), 60) == 0);
+  // The same route with the stretch seen once: it stands out and is published with the margin too.
+  const std::vector<int> once(tags.begin() + 10, tags.end());
+  const std::vector<FrameRevisit> revisits = publishedRevisits(once, similarity, 0.5);
+  CHECK(published(revisits, 50) >= 8);
+  for (std::size_t f = 50; f < 60; ++f)
+    if (revisits[f].match_frame >= 0) CHECK(once[static_cast<std::size_t>(revisits[f].match_frame)] == once[f]);
+}
+
+TEST_CASE("sequence loop closures: a third visit is published although it matches both earlier ones",
+          "[sequence_loops]") {
+  // A 60 s route driven three times in one stream (no clock reset): the third visit matches the first and
+  // the second alike. The second visit's published matches made them one place, so the third stands out.
+  std::vector<int> tags;
+  for (int visit = 0; visit < 3; ++visit)
+    for (int i = 0; i < 60; ++i) tags.push_back(i);
+  const test::TagSimilarity similarity = periodicSimilarity(0);
+  const std::vector<FrameRevisit> revisits = publishedRevisits(tags, similarity, 1.0);
+  int first = 0, second = 0, third = 0, wrong = 0;
+  for (std::size_t f = 0; f < tags.size(); ++f) {
+    const FrameRevisit& r = revisits[f];
+    if (r.match_frame < 0) continue;
+    if (tags[static_cast<std::size_t>(r.match_frame)] != tags[f]) {
+      ++wrong;
+      continue;
+    }
+    (f < 60 ? first : f < 120 ? second : third) += 1;
+  }
+  CHECK(first == 0);
+  CHECK(wrong == 0);
+  CHECK(second >= 55);
+  CHECK(third >= 55);
+}

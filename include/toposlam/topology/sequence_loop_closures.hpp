@@ -46,6 +46,9 @@ struct SequenceLoopConfig {
   /// keyframes of the diagonal's end that the new keyframe resembles most (the two visits' speeds differ a
   /// little, and a diagonal carried past the end of the earlier visit points where the robot is not).
   int align_keyframes = 1;
+  /// Diagonals ending within this many keyframes of the best one belong to its run; the best diagonal
+  /// outside (Detection::runner_up) says how distinct the detection is.
+  int distinct_keyframes = 5;
 
   /// Empty when valid, else what is wrong (names the setting).
   std::string validate() const;
@@ -64,6 +67,9 @@ class SequenceLoopDetector {
     double score = 0.0;          ///< the best diagonal's D_k / sigma_k (> 0 when detected)
     double relative = 0.0;       ///< this keyframe's own z with the diagonal's end (not integrated)
     std::int64_t diagonal = -1;  ///< where the best diagonal ends, before alignment
+    /// The best score of a diagonal ending more than distinct_keyframes from it (0: none): a periodic
+    /// building gives several runs alike, a revisit one that stands out.
+    double runner_up = 0.0;
   };
 
   /// similarities[g]: the new keyframe against earlier keyframe g, for every g < keyframes().
@@ -80,14 +86,19 @@ class SequenceLoopDetector {
   std::vector<std::size_t> continuations(std::size_t per_memory) const;
 
   std::int64_t keyframes() const { return static_cast<std::int64_t>(starts_run_.size()); }
+  /// The latest keyframe was published as back at `earlier`: from now on the two count as one place, so a
+  /// later visit's runs to both are one run, not a runner-up (a third visit stands out as well as the second).
+  void link(std::int64_t earlier);
 
  private:
   SequenceLoopConfig config_;
   std::vector<std::vector<double>> integrated_;  ///< per memory: D_k(latest keyframe, g) for g < latest
   std::vector<double> next_;                     ///< scratch, reused
   std::vector<double> z_;                        ///< scratch: this keyframe's relative similarities
+  std::vector<double> score_;                    ///< scratch: each earlier keyframe's best score
   Detection integrate(const std::vector<double>& similarities, bool continues_previous);
   std::vector<bool> starts_run_;    ///< per keyframe: the first of its traversal
+  std::vector<std::int64_t> place_;  ///< per keyframe: the earliest keyframe of its place (itself unless linked)
 };
 
 /// Sequence evidence for the topology filter (docs/topology.md, "Sequence evidence in the filter"): the
@@ -105,6 +116,11 @@ struct SequenceEvidenceConfig {
   /// The detection's score (in its noise's standard deviations, SequenceLoopDetector) needed to count: to
   /// be published as a frame's match and to vote for the filter's evidence.
   double min_score = 2.0;
+  /// ... and stand out from every other run by this much (standard deviations): a run as good as another
+  /// one elsewhere (Detection::runner_up) cannot say where the robot is. Earlier places it was published
+  /// back at count as one place, so a third visit stands out as well as the second.
+  double min_margin = 0.5;
+  double distinct_s = 5.0;  ///< runs ending within this long of the best one are its own, not a runner-up
   /// Likelihood of an earlier place every keyframe of the new place detects into; 0 = off (the default:
   /// it closes look-alike stretches of one lap, docs/topology.md). 0.99 when turned on.
   double weight = 0.0;

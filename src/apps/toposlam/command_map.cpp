@@ -687,6 +687,15 @@ void addMapCommand(CLI::App& app) {
                   "and a keyframe's evidence to count")
       ->check(keyRange("topology.sequence_evidence.min_score"))
       ->capture_default_str();
+  cmd->add_option("--loop-min-margin", options->sequence.min_margin,
+                  "Frame-level loop closures (sequence): how far (standard deviations) a published match's run must "
+                  "stand out from every other run")
+      ->capture_default_str()
+      ->check(keyRange("topology.sequence_evidence.min_margin"));
+  cmd->add_option("--loop-distinct-s", options->sequence.distinct_s,
+                  "Frame-level loop closures (sequence): runs ending within this many seconds of the best are its own")
+      ->capture_default_str()
+      ->check(keyRange("topology.sequence_evidence.distinct_s"));
   cmd->add_option("--sequence-evidence-min-relative", options->sequence.min_relative,
                   "Filter: the keyframe's own relative similarity z with its detection needed for its evidence to count")
       ->check(CLI::Range(-1e6, 1e6))
