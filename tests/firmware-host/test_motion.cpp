@@ -218,6 +218,34 @@ TEST_CASE("GIVEN a controller clock that jumps ahead for good WHEN its frames go
   CHECK(s->forward_m == Approx(0.005));
 }
 
+TEST_CASE("GIVEN one checksummed frame stamped in the past (time 0) WHEN real 50 Hz frames follow THEN it is taken "
+          "as a restart and the real frames are refused for at most clock_tolerance_s, then used again",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  twl_wheel_odometry_t m{600000000, 0, 0, 300, 0, 0};  // the controller has been up 10 minutes
+  std::int64_t host = 9000000000;
+  e.onWheel(m, host);
+  twl_wheel_odometry_t past = m;
+  past.time_us = 0;
+  host += 10000;
+  CHECK_FALSE(e.onWheel(past, host));
+  CHECK(e.counters().restarts == 1);
+  int lost = 0;
+  std::optional<MotionSample> s;
+  for (int i = 0; i < 100 && !s; ++i) {
+    m.time_us += 20000;
+    m.left_um += 10000;
+    m.right_um += 10000;
+    host += 20000;
+    s = e.onWheel(m, host);
+    lost += s ? 0 : 1;
+  }
+  REQUIRE(s);
+  CHECK(s->utime == host);
+  CHECK(lost == 52);  // 1.0 s of refusals (51 frames), then the new reference
+  CHECK(e.counters().restarts == 2);
+}
+
 TEST_CASE("GIVEN a controller clock that runs slow WHEN the mapped time falls behind the host's by more than the "
           "tolerance THEN the offset is re-estimated, so a published time stays within it",
           "[firmware][motion]") {
