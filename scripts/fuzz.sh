@@ -8,7 +8,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${BUILD_DIR:-$root/build-fuzz}"
 seconds="${SECONDS_PER_TARGET:-${SECONDS_LIMIT:-600}}"
-targets="${TARGETS:-map_file config fingerprint image_header lcm_messages lcm_log firmware_link}"
+targets="${TARGETS:-map_file config fingerprint image_header lcm_messages lcm_log firmware_link motion_input}"
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \

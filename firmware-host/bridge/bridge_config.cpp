@@ -68,6 +68,15 @@ const std::vector<Key>& keys() {
        [](const YAML::Node& n, BridgeConfig& c) { c.motion.moving_turn_rps = number(n, 0, 10); }},
       {"motion.max_gap_s", "0.01 .. 10 s", "velocity samples further apart are not integrated",
        [](const YAML::Node& n, BridgeConfig& c) { c.motion.max_gap_s = number(n, 0.01, 10); }},
+      {"motion.max_speed_mps", "0.1 .. 1000 m/s",
+       "a sample faster, or an increment longer than this speed allows, is refused and counted",
+       [](const YAML::Node& n, BridgeConfig& c) { c.motion.max_speed_mps = number(n, 0.1, 1000); }},
+      {"motion.max_turn_rate_rps", "0.1 .. 1000 rad/s", "a sample turning faster is refused and counted",
+       [](const YAML::Node& n, BridgeConfig& c) { c.motion.max_turn_rate_rps = number(n, 0.1, 1000); }},
+      {"motion.clock_tolerance_s", "0.01 .. 3600 s",
+       "the controller's clock running ahead of the host's by more is refused and counted (a jump that lasts "
+       "longer is a restart); the published time falling behind by more is re-estimated",
+       [](const YAML::Node& n, BridgeConfig& c) { c.motion.clock_tolerance_s = number(n, 0.01, 3600); }},
   };
   return table;
 }

@@ -40,7 +40,8 @@ std::string describeCounters(const DecoderCounters& d, const MotionCounters& m) 
   std::snprintf(line, sizeof line,
                 "bytes %llu (skipped %llu), frames %llu, bad crc %llu, bad length %llu, bad header %llu, "
                 "unknown %llu, signed skipped %llu, mavlink1 skipped %llu, false starts %llu; motion samples %llu, "
-                "restarts %llu, gaps %llu, invalid %llu, heartbeats %llu",
+                "restarts %llu, gaps %llu, invalid %llu, refused off the clock %llu, refused implausible %llu, "
+                "clock resyncs %llu, heartbeats %llu",
                 static_cast<unsigned long long>(d.bytes_in), static_cast<unsigned long long>(d.bytes_skipped),
                 static_cast<unsigned long long>(d.frames), static_cast<unsigned long long>(d.bad_crc),
                 static_cast<unsigned long long>(d.bad_length), static_cast<unsigned long long>(d.bad_header),
@@ -48,7 +49,8 @@ std::string describeCounters(const DecoderCounters& d, const MotionCounters& m) 
                 static_cast<unsigned long long>(d.mavlink1_skipped), static_cast<unsigned long long>(d.false_starts),
                 static_cast<unsigned long long>(m.samples), static_cast<unsigned long long>(m.restarts),
                 static_cast<unsigned long long>(m.gaps), static_cast<unsigned long long>(m.invalid),
-                static_cast<unsigned long long>(m.heartbeats));
+                static_cast<unsigned long long>(m.off_clock), static_cast<unsigned long long>(m.implausible),
+                static_cast<unsigned long long>(m.clock_resyncs), static_cast<unsigned long long>(m.heartbeats));
   return line;
 }
 

@@ -222,6 +222,7 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.motion_messages = motion_ ? motion_->messages.load() : 0;
   msg.motion_state = toString(motion_ ? static_cast<MotionUse>(motion_->use.load()) : MotionUse::None);
   msg.motion_standing_frames = motion_ ? motion_->standing_frames.load() : 0;
+  msg.motion_refused = motion_ ? motion_->refused.load() : 0;
   msg.num_stages = static_cast<std::int32_t>(s.stages.size());
   msg.stages.reserve(s.stages.size());
   for (const StageStatus& st : s.stages) {
@@ -330,7 +331,7 @@ const WireSchema kPlaceV1 = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), f
 const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length(), array(1), fixed(8)};
 const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
 const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
-                            text(), fixed(8), length(), array(kStageStatus)};
+                            text(), fixed(8 + 8), length(), array(kStageStatus)};
 const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
 const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopologyNode), length(), array(12)};
 const WireSchema kMotion = {fixed(8 * 7 + 1)};
@@ -539,7 +540,7 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
       jsonNumber(w, "cpu_percent", m.cpu_percent);
       w.field("places", m.places).field("map_revision", m.map_revision).field("maps_saved", m.maps_saved)
           .field("motion_messages", m.motion_messages).field("motion_state", m.motion_state)
-          .field("motion_standing_frames", m.motion_standing_frames);
+          .field("motion_standing_frames", m.motion_standing_frames).field("motion_refused", m.motion_refused);
       w.key("stages").beginArray();
       for (const auto& st : m.stages) {
         w.beginObject().field("name", st.name);
@@ -561,6 +562,9 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
                     m.source_state.c_str(), static_cast<long long>(m.source_reconnects),
                     static_cast<long long>(m.source_dropped));
       out.summary = line;
+      if (const std::string motion = motionStatusText(m.motion_state, m.motion_standing_frames, m.motion_refused);
+          !motion.empty())
+        out.summary += "  " + motion;
     }
   } else {
     toposlam_lcm::motion_t m{};

@@ -398,6 +398,19 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("segmentation.motion.timeout_s", AT(segmentation_stage.motion.timeout_s), 1.0, 0, 3600, "seconds",
                    "motion is known while the newest sample is at most this old")
                   .exclusive(true, false));
+  k.push_back(real("segmentation.motion.clock_tolerance_s", AT(segmentation_stage.motion.clock_tolerance_s), 1.0, 0,
+                   3600, "seconds",
+                   "a sample stamped further than this from the receiver's clock (CLOCK_MONOTONIC) is refused and "
+                   "counted, and never becomes the reference")
+                  .exclusive(true, false));
+  k.push_back(real("segmentation.motion.max_speed_mps", AT(segmentation_stage.motion.max_speed_mps), 5.0, 0, 1000,
+                   "m/s",
+                   "a faster sample, or a distance increment longer than this speed allows, cannot be the robot: "
+                   "refused and counted")
+                  .exclusive(true, false));
+  k.push_back(real("segmentation.motion.max_turn_rate_rps", AT(segmentation_stage.motion.max_turn_rate_rps), 10.0, 0,
+                   1000, "rad/s", "a sample turning faster cannot be the robot: refused and counted")
+                  .exclusive(true, false));
   k.push_back(real("segmentation.valley.gamma", AT(segmentation.valley.gamma), 0.5, 0, 2, "",
                    "peak height on the lambda2 scale (thesis: 0.5)")
                   .withNote("and <= window / (window - 1)")

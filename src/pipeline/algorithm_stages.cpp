@@ -52,6 +52,28 @@ void FiedlerSegmentationStage::addMotion(const MotionSample& sample) {
   pending_motion_.push_back(sample);
 }
 
+MotionUse FiedlerSegmentationStage::motionUse() const {
+  if (last_motion_.known) return MotionUse::Used;
+  if (gate_.refusedSinceAccepted() > 0) return MotionUse::Stale;
+  return gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
+}
+
+// A refusal is the world's bad input: logged for the first few of each reason, then every 1000th.
+void FiedlerSegmentationStage::warnOfRefusals(const MotionRefusals& before) const {
+  const MotionRefusals& now = gate_.refusals();
+  const auto warn = [](std::int64_t was, std::int64_t is, const char* why) {
+    for (std::int64_t n = was + 1; n <= is; ++n)
+      if (n <= 3 || n % 1000 == 0) {
+        spdlog::warn("segmentation: motion sample refused: {} ({} such so far; segmentation.motion)", why, n);
+        return;
+      }
+  };
+  warn(before.not_finite, now.not_finite, "a value is not finite");
+  warn(before.off_clock, now.off_clock, "its time is further from the receiver's clock than clock_tolerance_s");
+  warn(before.implausible, now.implausible, "faster or turning faster than max_speed_mps / max_turn_rate_rps");
+  warn(before.earlier, now.earlier, "earlier than the newest sample");
+}
+
 std::int64_t FiedlerSegmentationStage::droppedMotionSamples() const {
   const std::lock_guard<std::mutex> lock(motion_mutex_);
   return dropped_motion_;
@@ -64,14 +86,21 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
     const std::lock_guard<std::mutex> lock(motion_mutex_);
     applying_.swap(pending_motion_);
   }
-  for (const MotionSample& m : applying_) gate_.addSample(m.time_s, m.distance_increment_m, m.speed_mps, m.turn_rate_rps);
+  const MotionRefusals refused_before = gate_.refusals();
+  for (const MotionSample& m : applying_)
+    gate_.addSample(m.time_s, m.distance_increment_m, m.speed_mps, m.turn_rate_rps, m.received_s);
   applying_.clear();
+  warnOfRefusals(refused_before);
   const bool was_known = last_motion_.known;
   last_motion_ = gate_.at(captured_at_s);
   if (last_motion_.known != was_known) {
     if (last_motion_.known) {
       spdlog::info("segmentation: robot motion known; standing frames skipped{}",
                    segmenter_->config().window_m > 0.0 ? ", window in metres" : "");
+    } else if (gate_.refusedSinceAccepted() > 0) {
+      spdlog::warn("segmentation: robot motion stale (no usable sample for {} s, {} refused since the last one); "
+                   "segmenting by time",
+                   gate_.config().timeout_s, gate_.refusedSinceAccepted());
     } else if (gate_.samples() > 0) {
       spdlog::warn("segmentation: robot motion lost (no sample for {} s); segmenting by time",
                    gate_.config().timeout_s);
@@ -102,9 +131,9 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
   if (evidence_) revisit = evidence_->addFrame(sequence, time_s, fingerprint);
   SegmenterStep step = segmenter_->addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
   if (motion_counters_ != nullptr) {
-    const MotionUse use = last_motion_.known ? MotionUse::Used : gate_.samples() > 0 ? MotionUse::Lost : MotionUse::None;
-    motion_counters_->use.store(static_cast<int>(use));
+    motion_counters_->use.store(static_cast<int>(motionUse()));
     motion_counters_->standing_frames.store(skippedFrames());
+    motion_counters_->refused.store(gate_.rejectedSamples());
   }
   SegmentationStep out;
   last_closed_.reset();

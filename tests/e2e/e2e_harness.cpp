@@ -201,6 +201,8 @@ MotionStatusHistory motionStatusHistory(const std::vector<ReceivedMessage>& stat
     if (h.first_lost < 0 && json.find("\"motion_state\":\"lost\"") != std::string::npos)
       h.first_lost = static_cast<int>(i);
     h.standing_frames = std::max(h.standing_frames, integerField(statuses[i], "motion_standing_frames"));
+    if (json.find("\"motion_refused\"") != std::string::npos)
+      h.refused = std::max(h.refused, integerField(statuses[i], "motion_refused"));
   }
   if (!statuses.empty()) h.messages = integerField(statuses.back(), "motion_messages");
   return h;

@@ -113,6 +113,7 @@ struct MotionStatusHistory {
   int first_lost = -1;               ///< index of the first status saying "lost", -1: none did
   std::int64_t standing_frames = 0;  ///< largest motion_standing_frames
   std::int64_t messages = -1;        ///< motion_messages of the last status, -1 without a status
+  std::int64_t refused = 0;          ///< largest motion_refused
 };
 MotionStatusHistory motionStatusHistory(const std::vector<ReceivedMessage>& statuses);
 

@@ -416,3 +416,67 @@ SCENARIO("Robot motion over LCM: the status says it is used while it arrives, an
     }
   }
 }
+
+SCENARIO("One motion message stamped with the wall clock among the robot's: refused and counted, the stop still seen") {
+  GIVEN("toposlamd on the simulated office at 25 fps and a robot node standing for 4 s, with one message in Unix time") {
+    const fs::path dir = freshDirectory("motion-wall-clock");
+    Heard heard;
+    auto subscriber = subscribe(heard);
+    auto robot = openLcm(kLcmUrl);
+    Daemon daemon({"--source", kRoute + "&rate=25", "--overflow", "block", "--map", (dir / "map.tsm").string(),
+                   "--no-map-load", "--lcm-url", kLcmUrl},
+                  "", dir / "toposlamd.log");
+    const auto started = std::chrono::steady_clock::now();
+    std::optional<std::chrono::steady_clock::time_point> motion_from, next_sample;
+    std::int64_t sequence = 0, first_sample_us = -1, last_sample_us = -1;
+    bool sent_stop = false;
+    const int code = listenUntilExit(*subscriber, daemon, 60.0, [&] {
+      const auto now = std::chrono::steady_clock::now();
+      if (!motion_from && !heard.statuses.empty()) motion_from = next_sample = now;
+      if (motion_from && now - *motion_from < std::chrono::seconds(4) && now >= *next_sample) {
+        *next_sample += std::chrono::milliseconds(50);
+        toposlam_lcm::motion_t m{};
+        m.utime = monotonicMicroseconds();
+        if (first_sample_us < 0) first_sample_us = m.utime;
+        last_sample_us = m.utime;
+        m.sequence = sequence++;
+        robot->publish(LcmChannels{}.motion, &m);
+        if (sequence == 10) {  // 0.5 s in: a node stamping utime with the wall clock (about 1.8e15 us)
+          toposlam_lcm::motion_t wall = m;
+          wall.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                           std::chrono::system_clock::now().time_since_epoch())
+                           .count();
+          robot->publish(LcmChannels{}.motion, &wall);
+        }
+      }
+      const bool lost = !heard.statuses.empty() &&
+                        heard.statuses.back().json.find("\"motion_state\":\"lost\"") != std::string::npos;
+      if (!sent_stop && (lost || now - started > std::chrono::seconds(30))) {
+        daemon.terminate();
+        sent_stop = true;
+      }
+    });
+    THEN("the message is refused and counted; the robot's samples are still used, so its stop is seen") {
+      CHECK(code == 0);
+      REQUIRE(sequence > 40);
+      REQUIRE_FALSE(heard.statuses.empty());
+      const e2e::MotionStatusHistory status = e2e::motionStatusHistory(heard.statuses);
+      INFO("last status " << heard.statuses.back().json);
+      CHECK(status.refused == 1);
+      CHECK(status.first_used >= 0);
+      CHECK(status.first_lost > status.first_used);
+      // As in the scenario without the stray message: standing from 1 s after the first sample to 1 s after
+      // the last (before issue 41's fix: about none, every sample after the stray one was "earlier").
+      const std::int64_t expected =
+          e2e::framesCapturedIn(heard.places, static_cast<double>(first_sample_us + 1'000'000),
+                                static_cast<double>(last_sample_us + 1'000'000));
+      const std::int64_t standing = status.standing_frames;
+      INFO("standing frames " << standing << ", frames captured while standing " << expected);
+      CHECK(standing >= 25);
+      CHECK(std::abs(standing - expected) <= std::max<std::int64_t>(5, expected / 10));
+      std::ostringstream log;
+      log << std::ifstream(dir / "toposlamd.log").rdbuf();
+      CHECK(log.str().find("motion sample refused: its time is further from the receiver's clock") != std::string::npos);
+    }
+  }
+}

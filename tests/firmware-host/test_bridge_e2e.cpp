@@ -10,9 +10,13 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -21,6 +25,7 @@
 #include "e2e/e2e_harness.hpp"
 #include "toposlam/firmware/emulator.hpp"
 #include "toposlam/firmware/serial_port.hpp"
+#include "toposlam/firmware/wheel_link.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
 #include "toposlam_lcm/motion_t.hpp"
 
@@ -162,6 +167,75 @@ TEST_CASE("GIVEN MAVLink 2 ODOMETRY from a router on UDP localhost WHEN toposlam
   CHECK(bridge.output().find("signed skipped 0,") == std::string::npos);
   CHECK(bridge.output().find("mavlink1 skipped 0,") == std::string::npos);
   CHECK(bridge.output().find("signed skipped") != std::string::npos);
+}
+
+TEST_CASE("GIVEN checksummed wheel-link frames with controller time 2^62 and an absurd wheel step among real ones WHEN "
+          "toposlam-bridge reads them from a pty THEN it publishes only the real motion, on the host's clock, and "
+          "counts what it refused",
+          "[firmware][bridge][e2e]") {
+  Heard heard;
+  auto l = lcmOrSkip(heard);
+  PseudoTerminal pty = openPseudoTerminal();
+  Bridge bridge({"--serial", pty.slave_path, "--baud", "115200", "--protocol", "wheel", "--lcm-url", kLcmUrl,
+                 "--channel", kChannel, "--status-period", "0"});
+  REQUIRE(bridge.waitForOutput("-> LCM", 5000));
+
+  // 75 real frames 20 ms apart in real time (0.5 m/s: 10 mm each), the controller's clock running with the
+  // host's; after the 25th two frames at 2^62 us, after the 50th one whose left wheel steps 2^31 - 1 um.
+  const auto monotonic_us = [] {
+    return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  };
+  const std::int64_t start_us = monotonic_us();
+  std::uint8_t seq = 0;
+  const auto send = [&](const twl_wheel_odometry_t& m) {
+    std::uint8_t frame[64];
+    const std::size_t n = twl_encode_wheel_odometry(frame, sizeof frame, seq++, &m);
+    REQUIRE(n > 0);
+    REQUIRE(write(pty.master, frame, n) == static_cast<ssize_t>(n));
+  };
+  twl_wheel_odometry_t m{0, 0, 0, 300, TWL_ODOM_DRIVING, 0};
+  for (int i = 0; i < 75; ++i) {
+    m.time_us = static_cast<std::uint64_t>(monotonic_us() - start_us) + 1000000;
+    m.left_um = m.right_um = 10000 * i;
+    send(m);
+    if (i == 24) {
+      twl_wheel_odometry_t poison = m;
+      poison.time_us = std::uint64_t{1} << 62;
+      poison.left_um = poison.right_um = m.left_um + 10000;
+      send(poison);
+      send(poison);
+    }
+    if (i == 49) {
+      twl_wheel_odometry_t absurd = m;
+      absurd.time_us += 10000;
+      absurd.left_um = static_cast<std::int32_t>(static_cast<std::uint32_t>(m.left_um) + 0x7FFFFFFFu);  // wraps
+      send(absurd);
+    }
+    pump(*l, 20);
+  }
+  // The first frame is the reference; the one after the absurd frame is the new reference.
+  const std::size_t expected = 73;
+  collect(*l, heard, expected, 3000);
+  pump(*l, 300);  // anything more would be a message too many
+  const std::int64_t end_us = monotonic_us();
+  CHECK(bridge.stop() == 0);
+  INFO(bridge.output());
+  CHECK(heard.messages.size() == expected);
+  double forward = 0, largest_step = 0;
+  std::int64_t earliest = std::numeric_limits<std::int64_t>::max(), latest = 0;
+  for (const auto& msg : heard.messages) {
+    forward += msg.forward_m;
+    largest_step = std::max(largest_step, std::abs(msg.forward_m));
+    earliest = std::min(earliest, msg.utime);
+    latest = std::max(latest, msg.utime);
+  }
+  CHECK(forward == Approx(0.73).margin(1e-9));
+  CHECK(largest_step == Approx(0.01).margin(1e-9));
+  CHECK(earliest >= start_us);
+  CHECK(latest <= end_us);
+  CHECK(bridge.output().find("refused off the clock 2,") != std::string::npos);
+  CHECK(bridge.output().find("refused implausible 1,") != std::string::npos);
 }
 
 TEST_CASE("GIVEN no such device WHEN toposlam-bridge starts THEN it exits 1 (a runtime error) with an actionable message",

@@ -2,7 +2,11 @@
 // (bytes -> decoder -> estimator), with stops, speed changes, drops, bit errors and garbage.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "toposlam/firmware/emulator.hpp"
@@ -144,6 +148,183 @@ TEST_CASE("GIVEN MAVLink ODOMETRY heading east WHEN the drone moves east and yaw
     o.frame_id = 4;  // MAV_FRAME_LOCAL_ENU
     CHECK_FALSE(e.onMavlink(o, 1200000));
     CHECK(e.counters().invalid == 1);
+  }
+}
+
+TEST_CASE("GIVEN wheel odometry at 50 Hz WHEN two checksummed frames carry controller time 2^62 (or beyond int64) "
+          "THEN they are refused and counted with no overflow, and the real frames go on on the host's clock",
+          "[firmware][motion]") {
+  for (const std::uint64_t bogus : {std::uint64_t{1} << 62, std::uint64_t{1} << 63, ~std::uint64_t{0}}) {
+    INFO("controller time " << bogus);
+    MotionEstimator e;  // clock_tolerance_s 1 s
+    twl_wheel_odometry_t m{2000000, 0, 0, 300, TWL_ODOM_DRIVING, 0};
+    std::int64_t host = 7000000000;  // host CLOCK_MONOTONIC 7000 s, controller 2 s
+    e.onWheel(m, host);
+    for (int i = 0; i < 10; ++i) {
+      m.time_us += 20000;
+      m.left_um += 10000;
+      m.right_um += 10000;
+      host += 20000;
+      const auto s = e.onWheel(m, host);
+      REQUIRE(s);
+      CHECK(s->utime == host);
+    }
+    twl_wheel_odometry_t poison = m;
+    poison.time_us = bogus;
+    poison.left_um += 10000;
+    poison.right_um += 10000;
+    CHECK_FALSE(e.onWheel(poison, host + 100));
+    CHECK_FALSE(e.onWheel(poison, host + 200));
+    CHECK(e.counters().off_clock == 2);
+    CHECK(e.counters().restarts == 0);
+    // The next real frame: 40 ms of controller time after the last accepted one, 0.5 mm of travel each.
+    m.time_us += 40000;
+    m.left_um += 20000;
+    m.right_um += 20000;
+    host += 40000;
+    const auto s = e.onWheel(m, host);
+    REQUIRE(s);
+    CHECK(s->utime == host);
+    CHECK(s->forward_m == Approx(0.02));
+    CHECK(s->linear_velocity_mps == Approx(0.5));
+    CHECK(e.counters().samples == 11);
+  }
+}
+
+TEST_CASE("GIVEN a controller clock that jumps ahead for good WHEN its frames go on for longer than the tolerance "
+          "THEN it counts as a restart and the frames are used again, stamped on the host's clock",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  twl_wheel_odometry_t m{1000000, 0, 0, 300, 0, 0};
+  std::int64_t host = 50000000;
+  e.onWheel(m, host);
+  m.time_us += 3600000000;  // one hour ahead, and on from there at 10 Hz
+  int refused = 0;
+  std::optional<MotionSample> s;
+  for (int i = 0; i < 20 && !s; ++i) {
+    host += 100000;
+    m.time_us += 100000;
+    m.left_um += 5000;
+    m.right_um += 5000;
+    s = e.onWheel(m, host);
+    refused += s ? 0 : 1;
+  }
+  // Refused for 1.1 s (more than the 1 s tolerance), then the new reference, then a sample.
+  CHECK(e.counters().off_clock == 11);
+  CHECK(e.counters().restarts == 1);
+  CHECK(refused == 12);
+  REQUIRE(s);
+  CHECK(s->utime == host);
+  CHECK(s->forward_m == Approx(0.005));
+}
+
+TEST_CASE("GIVEN one checksummed frame stamped in the past (time 0) WHEN real 50 Hz frames follow THEN it is taken "
+          "as a restart and the real frames are refused for at most clock_tolerance_s, then used again",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  twl_wheel_odometry_t m{600000000, 0, 0, 300, 0, 0};  // the controller has been up 10 minutes
+  std::int64_t host = 9000000000;
+  e.onWheel(m, host);
+  twl_wheel_odometry_t past = m;
+  past.time_us = 0;
+  host += 10000;
+  CHECK_FALSE(e.onWheel(past, host));
+  CHECK(e.counters().restarts == 1);
+  int lost = 0;
+  std::optional<MotionSample> s;
+  for (int i = 0; i < 100 && !s; ++i) {
+    m.time_us += 20000;
+    m.left_um += 10000;
+    m.right_um += 10000;
+    host += 20000;
+    s = e.onWheel(m, host);
+    lost += s ? 0 : 1;
+  }
+  REQUIRE(s);
+  CHECK(s->utime == host);
+  CHECK(lost == 52);  // 1.0 s of refusals (51 frames), then the new reference
+  CHECK(e.counters().restarts == 2);
+}
+
+TEST_CASE("GIVEN a controller clock that runs slow WHEN the mapped time falls behind the host's by more than the "
+          "tolerance THEN the offset is re-estimated, so a published time stays within it",
+          "[firmware][motion]") {
+  MotionEstimator e;
+  twl_body_velocity_t v{0, 100, 0, 0};
+  std::int64_t host = 1000000;
+  e.onWheel(v, host);
+  std::int64_t worst_behind = 0;
+  for (int i = 0; i < 6000; ++i) {  // 20 minutes at 5 Hz; the controller loses 1 ms per second
+    v.time_us += 199800;
+    host += 200000;
+    const auto s = e.onWheel(v, host);
+    REQUIRE(s);
+    worst_behind = std::max(worst_behind, host - s->utime);
+  }
+  // 1 s behind after 16 min 40 s: re-estimated once, then 0.2 s behind again by the end.
+  CHECK(worst_behind <= 1000000);
+  CHECK(e.counters().clock_resyncs == 1);
+  CHECK(e.counters().off_clock == 0);
+}
+
+TEST_CASE("GIVEN checksummed frames with absurd values WHEN estimated THEN the plausibility limits refuse them "
+          "(counted) and no increment spans them",
+          "[firmware][motion]") {
+  SECTION("wheel odometry: both counters jump 2^31 um the opposite way on a 1 mm track: 4.3 million rad") {
+    MotionEstimator e;
+    twl_wheel_odometry_t m{1000000, 0, 0, 1, 0, 0};
+    e.onWheel(m, 1000000);
+    m.time_us += 20000;
+    m.left_um = std::numeric_limits<std::int32_t>::min();
+    m.right_um = std::numeric_limits<std::int32_t>::max();
+    CHECK_FALSE(e.onWheel(m, 1020000));
+    CHECK(e.counters().implausible == 1);
+    // The next frame is the new reference; the one after is a sample again.
+    m.time_us += 20000;
+    CHECK_FALSE(e.onWheel(m, 1040000));
+    m.time_us += 20000;
+    m.left_um += 100;
+    m.right_um += 100;
+    const auto s = e.onWheel(m, 1060000);
+    REQUIRE(s);
+    CHECK(s->forward_m == Approx(0.0001));
+    CHECK(s->turn_rad == 0.0);
+  }
+  SECTION("MAVLink ODOMETRY: the position jumps 945 km") {
+    MotionEstimator e;
+    mavlink::Odometry o;
+    o.time_usec = 1000000;
+    e.onMavlink(o, 1000000);
+    o.time_usec = 1020000;
+    o.x = 945000.0f;
+    CHECK_FALSE(e.onMavlink(o, 1020000));
+    CHECK(e.counters().implausible == 1);
+    CHECK(e.counters().samples == 0);
+  }
+  SECTION("body velocity: 2^31 mm/s forward, then 4.3 million mrad/s") {
+    MotionEstimator e;
+    twl_body_velocity_t v{0, 0, 0, 0};
+    e.onWheel(v, 0);
+    v.time_us = 20000;
+    v.vx_mm_s = std::numeric_limits<std::int32_t>::max();
+    CHECK_FALSE(e.onWheel(v, 20000));
+    v.vx_mm_s = 500;
+    v.time_us = 40000;
+    CHECK_FALSE(e.onWheel(v, 40000));  // the new reference
+    v.time_us = 60000;
+    v.wz_mrad_s = 4300000;
+    CHECK_FALSE(e.onWheel(v, 60000));
+    CHECK(e.counters().implausible == 2);
+  }
+  SECTION("just within the limits: 4.9 m/s and 9.9 rad/s are the robot's") {
+    MotionEstimator e;
+    twl_body_velocity_t v{0, 4900, 0, 9900};
+    e.onWheel(v, 0);
+    v.time_us = 20000;
+    const auto s = e.onWheel(v, 20000);
+    REQUIRE(s);
+    CHECK(s->forward_m == Approx(0.098));
+    CHECK(e.counters().implausible == 0);
   }
 }
 

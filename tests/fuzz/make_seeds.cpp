@@ -104,6 +104,38 @@ int main(int argc, char** argv) {
   topology.nodes[0].representative_frames = {3};
   write(out / "lcm_messages" / "topology", encoded('\3', topology));
   write(out / "lcm_messages" / "motion", encoded('\4', toposlam_lcm::motion_t{}));
+  // Motion input (records of [receiver clock step in 10 ms, length, motion_t]): 1 s of a robot driving at
+  // 0.5 m/s at 50 Hz on the receiver's clock (which starts at 1000 s), clean, with one message stamped by
+  // Unix time, and with an absurd one (945 km forward, 4.3 million rad/s).
+  {
+    auto motionRun = [](int poison_at, const toposlam_lcm::motion_t& poison) {
+      std::string seed;
+      for (int i = 0; i < 50; ++i) {
+        toposlam_lcm::motion_t m{};
+        m.utime = static_cast<std::int64_t>((1000.0 + 0.02 * (i + 1)) * 1e6);
+        m.sequence = i;
+        m.forward_m = 0.01;
+        m.linear_velocity_mps = 0.5;
+        m.moving = 1;
+        if (i == poison_at) {
+          m = poison;
+          m.utime = poison.utime != 0 ? poison.utime : static_cast<std::int64_t>((1000.0 + 0.02 * (i + 1)) * 1e6);
+          m.sequence = i;
+        }
+        const std::string bytes = encoded('\2', m);  // byte 0: the clock step (20 ms), then the length
+        seed += bytes.substr(0, 1) + std::string(1, static_cast<char>(bytes.size() - 1)) + bytes.substr(1);
+      }
+      return seed;
+    };
+    write(out / "motion_input" / "driving", motionRun(-1, {}));
+    toposlam_lcm::motion_t future{};
+    future.utime = 1'700'000'000'000'000;
+    write(out / "motion_input" / "unix-time-stamped", motionRun(20, future));
+    toposlam_lcm::motion_t absurd{};
+    absurd.forward_m = 945000.0;
+    absurd.angular_velocity_rps = 4.3e6;
+    write(out / "motion_input" / "absurd", motionRun(20, absurd));
+  }
   // Controller links: 1.5 s of each emulated message set (byte 0: protocol, byte 1: piece sizes), clean
   // and damaged.
   {

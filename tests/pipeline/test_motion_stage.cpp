@@ -109,3 +109,37 @@ TEST_CASE(
   CHECK(stage.lastMotion().distance_m ==
         Approx(0.001 * static_cast<double>(FiedlerSegmentationStage::kMaxPendingMotion)));
 }
+
+TEST_CASE("GIVEN motion samples stamped by another clock WHEN frames arrive THEN every sample is refused, the status "
+          "says stale and counts them, and samples on the right clock are used again at once",
+          "[pipeline][motion]") {
+  const TableSimilarity similarity(blocks);
+  FiedlerSegmentationStage stage(stageConfig(), similarity);  // default gate: clock_tolerance_s 1 s
+  toposlam::MotionStatusCounters counters;
+  stage.reportMotionTo(&counters);
+  // Frames on the pipeline clock from 100 s; the robot stands. For 2 s the samples carry Unix time.
+  for (int frame = 0; frame < 20; ++frame) {  // 100.0 .. 101.9 s
+    const double t = 100.0 + 0.1 * frame;
+    stage.addMotion(MotionSample{1.7e9 + t, 0.0, 0.0, 0.0, t});
+    stage.process(frame, t, t, fakeFingerprint(frame), cv::Mat());
+  }
+  CHECK(stage.refusedMotionSamples() == 20);
+  CHECK(stage.motionRefusals().off_clock == 20);
+  CHECK(stage.motionSamples() == 0);
+  CHECK(counters.use.load() == static_cast<int>(toposlam::MotionUse::Stale));
+  CHECK(counters.refused.load() == 20);
+  CHECK(toposlam::motionStatusText(counters) ==
+        "motion stale (segmenting by time), 0 standing frames skipped, motion refused 20");
+  CHECK(stage.skippedFrames() == 0);
+  // The sender fixed: its samples are used, and the stop is seen once it has lasted standing_after_s.
+  for (int frame = 20; frame < 40; ++frame) {  // 102.0 .. 103.9 s
+    const double t = 100.0 + 0.1 * frame;
+    stage.addMotion(MotionSample{t, 0.0, 0.0, 0.0, t});
+    stage.process(frame, t, t, fakeFingerprint(frame), cv::Mat());
+  }
+  CHECK(counters.use.load() == static_cast<int>(toposlam::MotionUse::Used));
+  CHECK(stage.skippedFrames() == 10);  // 103.0 .. 103.9 s
+  CHECK(toposlam::motionStatusText(counters) == "motion used, 10 standing frames skipped, motion refused 20");
+  CHECK(toposlam::motionStatusText("none", 0, 0).empty());
+  CHECK(toposlam::motionStatusText("lost", 3, 0) == "motion lost (segmenting by time), 3 standing frames skipped");
+}

@@ -133,3 +133,80 @@ TEST_CASE("GIVEN a robot turning on the spot WHEN asked THEN it is moving, and i
   CHECK_FALSE(gate.addSample(t += 0.1, 0.0, 0.0, std::numeric_limits<double>::infinity()));
   CHECK(gate.rejectedSamples() == 1);
 }
+
+// Issue 41's poisoning: the samples of a robot that drives 2 s and then stands 3 s, at 50 Hz on the
+// receiver's CLOCK_MONOTONIC (1000 s after boot), with one message stamped by a sender's wall clock
+// (1.7e9 s, Unix time) in between.
+TEST_CASE("GIVEN one sample stamped far in the future WHEN real samples follow THEN it is refused and counted, the "
+          "real samples are still used and the stop is still detected",
+          "[motion_gate]") {
+  MotionGate gate(gateConfig());
+  double t = 1000.0;
+  for (int i = 0; i < 100; ++i, t += 0.02) REQUIRE(gate.addSample(t, 0.01, 0.5, 0.0, t + 0.001));
+  CHECK_FALSE(gate.addSample(1.7e9, 0.01, 0.5, 0.0, t));
+  CHECK(gate.refusals().off_clock == 1);
+  CHECK(gate.refusedSinceAccepted() == 1);
+  int taken = 0;
+  for (int i = 0; i < 150; ++i, t += 0.02) taken += gate.addSample(t, 0.0, 0.0, 0.0, t + 0.001) ? 1 : 0;
+  CHECK(taken == 150);
+  CHECK(gate.refusedSinceAccepted() == 0);
+  CHECK(gate.rejectedSamples() == 1);
+  CHECK(gate.samples() == 250);
+  const MotionState s = gate.at(t);
+  CHECK(s.known);
+  CHECK(s.standing);  // slow since 1002.0 s, asked at 1005.0 s
+  CHECK(s.distance_m == Approx(1.0));
+}
+
+TEST_CASE("GIVEN samples off the receiver's clock WHEN added THEN only those beyond clock_tolerance_s are refused, "
+          "in both directions, and without a receiver clock nothing is",
+          "[motion_gate]") {
+  MotionGateConfig c = gateConfig();
+  c.clock_tolerance_s = 1.0;
+  MotionGate gate(c);
+  CHECK(gate.addSample(100.9, 0.0, 0.0, 0.0, 100.0));  // 0.9 s ahead: within
+  CHECK_FALSE(gate.addSample(101.2, 0.0, 0.0, 0.0, 100.1));  // 1.1 s ahead
+  CHECK_FALSE(gate.addSample(101.0, 0.0, 0.0, 0.0, 102.5));  // 1.5 s behind
+  CHECK(gate.refusals().off_clock == 2);
+  // Ahead by up to the tolerance, a sample shadows what comes after it for at most that long.
+  CHECK_FALSE(gate.addSample(100.5, 0.0, 0.0, 0.0, 100.5));
+  CHECK(gate.refusals().earlier == 1);
+  CHECK(gate.addSample(101.0, 0.0, 0.0, 0.0, 101.0));
+  // A recorded file: no receiver clock (NaN), no check.
+  CHECK(gate.addSample(5000.0, 0.0, 0.0));
+  CHECK(gate.rejectedSamples() == 3);
+  CHECK(gate.samples() == 3);
+}
+
+TEST_CASE("GIVEN absurd but well-formed samples (945 km forward, 4.3 million rad/s) WHEN added THEN the "
+          "plausibility limits refuse them and the distance stays the robot's",
+          "[motion_gate]") {
+  MotionGateConfig c = gateConfig();
+  c.max_speed_mps = 5.0;
+  c.max_turn_rate_rps = 10.0;
+  MotionGate gate(c);
+  double t = 10.0;
+  for (int i = 0; i < 10; ++i, t += 0.02) REQUIRE(gate.addSample(t, 0.01, 0.5, 0.2, t));
+  CHECK_FALSE(gate.addSample(t, 945000.0, 0.5, 0.0, t));      // the increment: 5 m/s allows 2.5 m in 0.5 s
+  CHECK_FALSE(gate.addSample(t, 0.01, 945000.0 / 0.02, 0.0, t));  // the speed
+  CHECK_FALSE(gate.addSample(t, 0.0, 0.0, 4.3e6, t));         // the turn rate
+  CHECK_FALSE(gate.addSample(t, 0.0, 0.0, -10.5, t));         // a turn rate just beyond the limit
+  CHECK(gate.refusals().implausible == 4);
+  CHECK(gate.addSample(t, 2.4, 4.9, 9.9, t));  // just within: 2.4 m after 0.02 s (timeout 0.5 s x 5 m/s)
+  t += 3.0;
+  CHECK(gate.addSample(t, 14.0, 4.7, 0.0, t));  // 14 m after a 3 s gap: 4.7 m/s
+  CHECK(gate.distanceM() == Approx(0.1 + 2.4 + 14.0));
+  CHECK(gate.at(t).turned_rad == Approx(0.2 * 0.02 * 9 + 9.9 * 0.02));  // nothing over the 3 s gap
+}
+
+TEST_CASE("GIVEN an out-of-range tolerance or limit WHEN validated THEN the key is named", "[motion_gate]") {
+  MotionGateConfig c = gateConfig();
+  c.clock_tolerance_s = 0.0;
+  CHECK(c.validate().find("clock_tolerance_s") == 0);
+  c = gateConfig();
+  c.max_speed_mps = 0.0;
+  CHECK(c.validate().find("max_speed_mps") == 0);
+  c = gateConfig();
+  c.max_turn_rate_rps = 1001.0;
+  CHECK(c.validate().find("max_turn_rate_rps") == 0);
+}

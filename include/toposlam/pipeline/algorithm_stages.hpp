@@ -74,6 +74,9 @@ struct MotionSample {
   double distance_increment_m = 0.0;  ///< travelled since the previous sample
   double speed_mps = 0.0;
   double turn_rate_rps = 0.0;  ///< yaw rate, rad/s (0 when the source has none)
+  /// Pipeline clock when the sample was received, checked against time_s (MotionGateConfig's
+  /// clock_tolerance_s); NaN: no receiver clock (a recorded file), not checked.
+  double received_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// FiedlerSegmenter. Keeps the thumbnails of the open place's frames (at most `max_thumbnails`, oldest
@@ -122,11 +125,13 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   void addMotion(const MotionSample& sample);
   static constexpr std::size_t kMaxPendingMotion = 4096;
   /// Segmentation thread (or after it ended): the gate's state at the last frame, frames skipped as
-  /// standing, samples the gate refused (time going back, not finite) or that overflowed the queue.
+  /// standing, samples the gate refused (not finite, off the clock, implausible, time going back; by
+  /// reason in motionRefusals()) or that overflowed the queue.
   MotionState lastMotion() const { return last_motion_; }
   std::int64_t skippedFrames() const { return skipped_before_ + segmenter_->skippedFrames(); }
   std::int64_t motionSamples() const { return gate_.samples(); }  ///< samples the gate took
   std::int64_t refusedMotionSamples() const { return gate_.rejectedSamples(); }
+  const MotionRefusals& motionRefusals() const { return gate_.refusals(); }
   std::int64_t droppedMotionSamples() const;
   /// Segmentation thread (or after it ended): frames whose source time went back, which the window's
   /// clock carried on from the frame before (FrameTimeline).
@@ -138,11 +143,15 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   /// From now on, every frame writes whether motion is used and the standing frames so far into
   /// `counters` (may be null: nowhere), which must outlive the stage; any thread may read them.
   void reportMotionTo(MotionStatusCounters* counters) { motion_counters_ = counters; }
+  /// Segmentation thread: whether the last frame used motion (MotionUse).
+  MotionUse motionUse() const;
 
  private:
   /// The pipeline's record of a place the segmenter closed (nullopt when it was dropped); frees the
   /// thumbnails of its frames.
   std::optional<ClosedPlace> toClosedPlace(const SegmentedPlace& place);
+  /// Logs the gate's refusals since `before`, a few of each reason.
+  void warnOfRefusals(const MotionRefusals& before) const;
 
   const SimilarityMeasure& similarity_;
   std::optional<FiedlerSegmenter> segmenter_;        ///< always set; a fresh one per traversal

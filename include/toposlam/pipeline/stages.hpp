@@ -212,10 +212,25 @@ enum class MotionUse : int {
   None = 0,  ///< no motion sample has arrived: segmenting by time
   Used = 1,  ///< samples are fresh: standing frames are skipped (and the window is in metres, if set)
   Lost = 2,  ///< samples arrived, but none within the gate's timeout: segmenting by time again
+  /// none within the timeout either, and the samples since the newest accepted one were refused (off the
+  /// receiver's clock, implausible, ...): they arrive but cannot be used; segmenting by time
+  Stale = 3,
 };
-/// "none", "used", "lost".
+/// "none", "used", "lost", "stale".
 inline const char* toString(MotionUse use) {
-  return use == MotionUse::Used ? "used" : use == MotionUse::Lost ? "lost" : "none";
+  return use == MotionUse::Used ? "used" : use == MotionUse::Lost ? "lost" : use == MotionUse::Stale ? "stale" : "none";
+}
+
+/// The motion part of a status line, from the status message's motion_state, standing frames and refused
+/// samples: "motion used, 12 standing frames skipped", "motion stale (segmenting by time), 0 standing frames
+/// skipped, motion refused 3"; "" while no motion arrived and none was refused.
+inline std::string motionStatusText(const std::string& state, std::int64_t standing_frames, std::int64_t refused) {
+  if (state == toString(MotionUse::None) && refused == 0) return "";
+  std::string text = "motion " + state;
+  if (state == toString(MotionUse::Lost) || state == toString(MotionUse::Stale)) text += " (segmenting by time)";
+  text += ", " + std::to_string(standing_frames) + " standing frames skipped";
+  if (refused > 0) text += ", motion refused " + std::to_string(refused);
+  return text;
 }
 
 /// Robot motion as the daemon sees it, for the status message: the LCM receive thread counts messages,
@@ -224,7 +239,13 @@ struct MotionStatusCounters {
   std::atomic<std::int64_t> messages{0};         ///< motion messages received
   std::atomic<int> use{static_cast<int>(MotionUse::None)};  ///< a MotionUse, at the last frame
   std::atomic<std::int64_t> standing_frames{0};  ///< frames left out of segmentation as standing
+  std::atomic<std::int64_t> refused{0};          ///< samples the motion gate refused (MotionRefusals::total)
 };
+/// motionStatusText of the counters as they are now.
+inline std::string motionStatusText(const MotionStatusCounters& counters) {
+  return motionStatusText(toString(static_cast<MotionUse>(counters.use.load())), counters.standing_frames.load(),
+                          counters.refused.load());
+}
 
 struct PipelineStatus {
   double time_s = 0.0;          ///< pipeline clock

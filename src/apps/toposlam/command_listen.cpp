@@ -4,13 +4,17 @@
 //
 // It reads the daemon's config (-c FILE, else the same look-up as toposlamd) for lcm.url and the channel
 // names, so a robot whose config renames the channels needs no extra options. Ctrl-C and SIGTERM end it
-// with exit status 0 (and, with --hz, the per-channel message rates).
+// with exit status 0 (and, with --hz, the per-channel message rates). A STATUS line ends with the motion
+// input's state ("motion stale (segmenting by time), ..., motion refused 20"); listening live, --hz also
+// says how many motion messages were stamped further than segmentation.motion.clock_tolerance_s from this
+// host's CLOCK_MONOTONIC, the messages toposlamd on this host refuses.
 //
 // `--from lcmlog:FILE` replays a recorded LCM log instead (lcm-logger's format, or toposlamd's own with
 // `lcm.url: file://FILE?mode=w`), read with the pure LcmLogReader: the same lines, as fast as read; --hz
 // rates over the log's own time. `--run-folder DIR` also turns it into a run folder for `toposlam report`.
 // A corrupt or truncated log is an error naming the byte offset (after the messages before it).
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -70,6 +74,11 @@ std::string resolveChannel(const std::string& item, const LcmChannels& known) {
   if (item == "status") return known.status;
   if (item == "motion") return known.motion;
   return item;
+}
+
+/// CLOCK_MONOTONIC (steady_clock on Linux), seconds: the clock of motion_t.utime on this host.
+double monotonicSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 std::string formatRate(double value) {
@@ -132,16 +141,28 @@ void addListenCommand(CLI::App& app) {
     long long printed = 0;
     std::map<std::string, long long> per_channel;
     for (const std::string& c : channels) per_channel[c] = 0;
+    // Motion messages stamped off this host's clock, live only (a log's times are not this clock's).
+    long long motion_off_clock = 0;
+    bool live = false;
     auto printRates = [&](double seconds) {
       if (!options->hz) return;
       for (const auto& [channel, n] : per_channel) {
         const std::string hz = formatRate(seconds > 0 ? static_cast<double>(n) / seconds : 0.0);
-        if (options->json)
+        const bool off_clock_known = live && channel == known.motion;
+        if (options->json) {
           std::cout << "{\"rate\":{\"channel\":\"" << JsonWriter::escape(channel) << "\",\"messages\":" << n
-                    << ",\"seconds\":" << formatRate(seconds) << ",\"hz\":" << hz << "}}\n";
-        else
+                    << ",\"seconds\":" << formatRate(seconds) << ",\"hz\":" << hz;
+          if (off_clock_known) std::cout << ",\"off_clock\":" << motion_off_clock;
+          std::cout << "}}\n";
+        } else {
           std::cout << "rate " << channel << ": " << n << " messages in " << formatRate(seconds) << " s = " << hz
-                    << " Hz\n";
+                    << " Hz";
+          if (off_clock_known)
+            std::cout << ", " << motion_off_clock << " stamped more than "
+                      << formatRate(config.segmentation_stage.motion.clock_tolerance_s)
+                      << " s off this host's clock (refused by toposlamd)";
+          std::cout << "\n";
+        }
       }
       std::cout << std::flush;
     };
@@ -180,8 +201,12 @@ void addListenCommand(CLI::App& app) {
       return;
     }
     blockStopSignals();  // until the handlers are in place: a signal now waits for them
+    live = true;
     LcmSubscriber subscriber(url, known, channels, [&](const ReceivedMessage& m) {
       ++per_channel[m.channel];
+      if (m.kind == "motion" && !(std::abs(m.motion_time_s - monotonicSeconds()) <=
+                                  config.segmentation_stage.motion.clock_tolerance_s))
+        ++motion_off_clock;
       if (options->count > 0 && printed >= options->count) return;
       std::cout << (options->json ? m.json : m.summary) << "\n" << std::flush;
       ++printed;

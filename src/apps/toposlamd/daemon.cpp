@@ -306,7 +306,9 @@ int runDaemon(const DaemonConfig& config) {
   segmentation_stage.reportMotionTo(&motion_status);
   LcmSubscriber motion(config.lcm.url, channels, {channels.motion}, [&](const ReceivedMessage& m) {
     motion_status.messages.fetch_add(1);
-    segmentation_stage.addMotion(MotionSample{m.motion_time_s, m.motion_distance_m, m.motion_speed_mps, m.motion_turn_rate_rps});
+    // Stamped on arrival: the gate refuses a sample whose utime is off this clock (clock_tolerance_s).
+    segmentation_stage.addMotion(MotionSample{m.motion_time_s, m.motion_distance_m, m.motion_speed_mps,
+                                              m.motion_turn_rate_rps, clock.now()});
   });
   LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_status);
 
@@ -362,9 +364,8 @@ int runDaemon(const DaemonConfig& config) {
       const std::string stalled = pipeline.stalledStages();
       std::string line = statusLine(pipeline.status());
       // Robot motion, once any has arrived: whether segmentation uses it (docs/segmentation.md).
-      if (const auto use = static_cast<MotionUse>(motion_status.use.load()); use != MotionUse::None)
-        line += std::string("; motion ") + toString(use) + (use == MotionUse::Lost ? " (segmenting by time)" : "") +
-                ", " + std::to_string(motion_status.standing_frames.load()) + " standing frames skipped";
+      if (const std::string motion_line = motionStatusText(motion_status); !motion_line.empty())
+        line += "; " + motion_line;
       if (recording != nullptr) line += "; " + recordingStatus(*recording);
       notifier.status(stalled.empty() ? line : "stalled: " + stalled + " without progress (watchdog pings withheld); " + line);
     }

@@ -131,6 +131,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
   motion.messages.store(5);
   motion.use.store(static_cast<int>(MotionUse::Used));
   motion.standing_frames.store(11);
+  motion.refused.store(3);
   const std::int64_t before_us = monotonicMicroseconds();
   {
     LcmPipelineSink sink("file://" + path + "?mode=w", channels, 95, &motion);
@@ -234,6 +235,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(m.motion_messages == 5);
     CHECK(m.motion_state == "used");
     CHECK(m.motion_standing_frames == 11);
+    CHECK(m.motion_refused == 3);
     REQUIRE(m.num_stages == 2);
     CHECK(m.stages[0].name == "capture");
     CHECK(m.stages[0].latency_median_ms == 0.5f);
@@ -268,6 +270,8 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK_THAT(received[2].json, Catch::Contains("\"match_node\":2"));
     CHECK(received[3].kind == "status");
     CHECK_THAT(received[3].json, Catch::Contains("\"frames_captured\":3000000001"));
+    CHECK_THAT(received[3].json, Catch::Contains("\"motion_refused\":3"));
+    CHECK_THAT(received[3].summary, Catch::EndsWith("  motion used, 11 standing frames skipped, motion refused 3"));
   }
 }
 
