@@ -116,15 +116,25 @@ void MapStore::writeAtomically(const std::filesystem::path& path, std::string_vi
     throw MapStoreError("cannot flush map " + path.string() + " to disk: " + errnoText(error) + unchanged);
   if (const int error = write.close(); error != 0)
     throw MapStoreError("cannot close map " + path.string() + ": " + errnoText(error) + unchanged);
-  // Keep the file being replaced as <path>.prev (best effort: a hard link, no copy), but only when its
-  // framing verifies: a damaged file must not push the last good map out of <path>.prev.
-  if (fileVerifies(path)) {
-    const std::string previous_temp = previousTemporaryPath(write.temporaryPath());
-    if (linkFile(path, previous_temp) == 0 && renameFile(previous_temp, previousPath(path)) != 0)
-      removeFile(previous_temp);
+  // The file being replaced becomes <path>.prev by a rename, then the new file takes <path>: at every
+  // instant one of the two names holds a complete map, and they are never one file (a hard link made them
+  // one until the second rename, so a kill in between left no older map). Between the renames <path> is
+  // missing for a moment; recovery then loads <path>.prev. Only a file whose framing verifies is kept: a
+  // damaged file must not push the last good map out of <path>.prev.
+  const std::filesystem::path previous = previousPath(path);
+  const bool keep_previous = fileVerifies(path);
+  if (keep_previous && ops.rename(path.c_str(), previous.c_str()) != 0) {
+    throw MapStoreError("cannot keep map " + path.string() + " as " + previous.string() + ": " +
+                        errnoText(errno) + unchanged);
   }
-  if (const int error = write.replaceTarget(); error != 0)
+  if (const int error = write.replaceTarget(ops); error != 0) {
+    // Put the map back under its own name (the older .prev went with the first rename).
+    if (keep_previous && ops.rename(previous.c_str(), path.c_str()) != 0) {
+      throw MapStoreError("cannot replace map " + path.string() + ": " + errnoText(error) +
+                          " (the previous map is kept as " + previous.string() + ")");
+    }
     throw MapStoreError("cannot replace map " + path.string() + ": " + errnoText(error) + unchanged);
+  }
   if (const int error = write.syncFolder(ops); error != 0) {
     throw MapStoreError("map " + path.string() +
                         " written but its directory could not be flushed: " + errnoText(error));

@@ -2,6 +2,7 @@
 // atomic save, refusal of damaged / truncated / newer files, a full disk, recovery, the lock, orphans.
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <random>
 #include <filesystem>
 #include <fstream>
@@ -482,4 +484,121 @@ TEST_CASE("GIVEN saves killed with SIGKILL at random moments WHEN the map is rec
   }
   // Some kills land inside a save (a temporary file left behind); how many depends on the machine's speed.
   WARN("orphaned temporary files removed after " << kRuns << " kills: " << orphans_removed);
+}
+
+namespace {
+
+/// Kills the process (SIGKILL, as kill -9 would) when a save makes its `kill_at`-th rename (1-based), before
+/// that rename happens: nothing after it runs, no destructor, no clean-up.
+class KillAtRename : public MapFileOps {
+ public:
+  explicit KillAtRename(int kill_at) : kill_at_(kill_at) {}
+  int rename(const char* from, const char* to) const override {
+    if (++renames_ == kill_at_) ::raise(SIGKILL);
+    return MapFileOps::rename(from, to);
+  }
+
+ private:
+  int kill_at_;
+  mutable int renames_ = 0;
+};
+
+/// The inode of `path`, or 0 when it does not exist.
+std::uintmax_t inodeOf(const fs::path& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uintmax_t>(st.st_ino) : 0;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a map and its .prev WHEN a save is killed before, between or after its two renames THEN map.tsm or "
+          ".prev is a complete map, they are never one file, and recovery loads the newest that was complete",
+          "[topology][map][reliability]") {
+  auto sim = placeSimilarity();
+  const TempFolder temp("kill-renames");
+  const fs::path& dir = temp.path;
+  const fs::path path = dir / "map.tsm";
+  const fs::path previous = dir / "map.tsm.prev";
+  const std::string older = MapStore::encode(*smallFilter(sim, 4), "older");
+  const std::string current = MapStore::encode(*smallFilter(sim, 8), "current");
+  const std::string next = MapStore::encode(*smallFilter(sim, 12), "next");
+  // kill_at 1: before the first rename (map -> .prev); 2: between the renames; 3: no kill (2 renames).
+  const int kill_at = GENERATE(1, 2, 3);
+  INFO("killed at rename " << kill_at);
+  MapStore::writeAtomically(path, older);
+  MapStore::writeAtomically(path, current);  // map.tsm = current, .prev = older
+  REQUIRE(readAll(previous) == older);
+  REQUIRE(inodeOf(path) != inodeOf(previous));
+
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    MapStore::writeAtomically(path, next, KillAtRename(kill_at));
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  CHECK(WIFSIGNALED(status) == (kill_at <= 2));
+
+  // At every instant one of the two names holds a complete map, and they are two files.
+  CHECK((MapStore::fileVerifies(path) || MapStore::fileVerifies(previous)));
+  if (fs::exists(path) && fs::exists(previous)) CHECK(inodeOf(path) != inodeOf(previous));
+  const std::string expected_map = kill_at == 1 ? current : kill_at == 2 ? "" : next;
+  const std::string expected_previous = kill_at == 1 ? older : current;
+  CHECK((fs::exists(path) ? readAll(path) : std::string()) == expected_map);
+  CHECK(readAll(previous) == expected_previous);
+
+  // The next start: the killed save's temporary goes, the newest complete map loads.
+  CHECK(MapStore::removeOrphanedTemporaries(path) == (kill_at <= 2 ? 1 : 0));
+  RecoveredMap recovered = MapStore::recover(path, sim);
+  REQUIRE(recovered.map);
+  CHECK(recovered.problems.empty());
+  CHECK(recovered.map->application_data == (kill_at == 1 ? "current" : kill_at == 2 ? "current" : "next"));
+  CHECK(recovered.loaded_from == (kill_at == 2 ? previous : path));
+  // And the next save after it restores both names, as two files.
+  MapStore::writeAtomically(path, next);
+  CHECK(MapStore::fileVerifies(path));
+  CHECK(inodeOf(path) != inodeOf(previous));
+  CHECK(namesIn(dir) == std::vector<std::string>{"map.tsm", "map.tsm.prev"});
+}
+
+namespace {
+
+/// Fails a save's `fail_at`-th rename (1-based) with EIO.
+class FailRename : public MapFileOps {
+ public:
+  explicit FailRename(int fail_at) : fail_at_(fail_at) {}
+  int rename(const char* from, const char* to) const override {
+    if (++renames_ == fail_at_) {
+      errno = EIO;
+      return -1;
+    }
+    return MapFileOps::rename(from, to);
+  }
+
+ private:
+  int fail_at_;
+  mutable int renames_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("GIVEN a map WHEN the rename that puts the new map in place fails THEN the map is back under its name",
+          "[topology][map][reliability]") {
+  auto sim = placeSimilarity();
+  const TempFolder temp("fail-rename");
+  const fs::path path = temp.path / "map.tsm";
+  const std::string current = MapStore::encode(*smallFilter(sim, 8), "current");
+  MapStore::writeAtomically(path, current);
+  const int fail_at = GENERATE(1, 2);
+  try {
+    MapStore::writeAtomically(path, MapStore::encode(*smallFilter(sim, 12), "next"), FailRename(fail_at));
+    FAIL("the save did not fail");
+  } catch (const MapStoreError& e) {
+    INFO(e.what());
+    CHECK_THAT(e.what(), Catch::Contains(path.string()) && Catch::Contains(std::strerror(EIO)) &&
+                             Catch::Contains("the previous map file is unchanged"));
+  }
+  CHECK(readAll(path) == current);
+  CHECK(namesIn(temp.path) == std::vector<std::string>{"map.tsm"});
 }
