@@ -13,7 +13,9 @@
 // a place is spread over the following frames: per frame the topology thread spends at most
 // `filter_budget_ms` in TopologyStage::advance(). A status is published every `status_period_s`. The map
 // is saved atomically every `MapConfig::save_period_s` and at stop: the topology thread takes an in-memory
-// snapshot, the map writer thread writes it (fsync off the frame path).
+// snapshot, the map writer thread writes it (fsync off the frame path). A write that fails is retried
+// with a growing wait (a newer snapshot takes its place), counted in the status (map_save_failures) while
+// the run goes on; the final save is tried three times before it is the pipeline's error.
 //
 // The capture thread reads the source with a bounded wait (FrameSource::nextFor), so it keeps beating
 // while a camera is silent or reconnecting: that is healthy, and the status says "reconnecting". A stage
@@ -184,6 +186,9 @@ class Pipeline {
   void mapWriterLoop();
   /// Snapshot now (topology thread, when idle) and hand it to the map writer; `final` at stop.
   void saveMap(bool final);
+  /// Writes one snapshot (map writer thread): true when it is on disk; a failure is counted, logged and
+  /// kept for the status (the final save is tried kFinalSaveAttempts times before it is an error).
+  bool writeMap(const MapWrite& job);
   void beat(StageIndex stage);
   /// A stage waiting on its input queue (true) or working on an item (false).
   void setWaiting(StageIndex stage, bool waiting) { waiting_[stage].store(waiting); }
@@ -222,6 +227,8 @@ class Pipeline {
   std::atomic<std::int64_t> maps_saved_{0};
   std::atomic<int> places_{0};
   std::atomic<std::int64_t> place_queue_kept_waits_{0};  ///< the place queue was full (topology thread)
+  std::atomic<std::int64_t> map_save_failures_{0};  ///< failed map writes since the last one that succeeded
+  std::string map_save_problem_;                    ///< the last failure's message (status_mutex_)
   std::atomic<std::size_t> place_queue_high_water_{0};
   // Copied by their owning thread so the publisher never calls into another thread's stage or source.
   std::atomic<std::int64_t> map_revision_{0};
