@@ -141,6 +141,37 @@ void MapStore::writeAtomically(const std::filesystem::path& path, std::string_vi
   }
 }
 
+void MapStore::checkWritable(const std::filesystem::path& path, const MapFileOps& ops) {
+  const std::string folder = folderOf(path).string();
+  const std::string cannot = "the map " + path.string() + " could not be saved: ";
+  std::error_code ec;
+  for (const std::filesystem::path& name : {path, previousPath(path)}) {
+    const std::filesystem::file_status status = std::filesystem::symlink_status(name, ec);
+    if (status.type() == std::filesystem::file_type::directory)
+      throw MapStoreError(cannot + name.string() + " is a directory; remove it or choose another map path");
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+        !std::filesystem::is_symlink(status))
+      throw MapStoreError(cannot + name.string() + " is not a regular file; remove it or choose another map path");
+  }
+  if (!std::filesystem::is_directory(folderOf(path), ec))
+    throw MapStoreError(cannot + "its folder " + folder + " does not exist (or is not a folder)");
+  // What a save does, on a probe file beside the map: create, write, fsync, rename; then remove it.
+  AtomicFileWrite probe(path, kTemporaryInfix);
+  if (const int error = probe.create(); error != 0)
+    throw MapStoreError(cannot + "cannot create a file in " + folder + ": " + errnoText(error));
+  const std::string probe_name = probePath(probe.temporaryPath());
+  if (const int error = probe.write("toposlam map save probe\n", ops); error != 0)
+    throw MapStoreError(cannot + "cannot write a file in " + folder + ": " + errnoText(error));
+  if (const int error = probe.sync(ops); error != 0)
+    throw MapStoreError(cannot + "cannot flush a file in " + folder + " to disk: " + errnoText(error));
+  if (const int error = probe.close(); error != 0)
+    throw MapStoreError(cannot + "cannot close a file in " + folder + ": " + errnoText(error));
+  if (ops.rename(probe.temporaryPath().c_str(), probe_name.c_str()) != 0)
+    throw MapStoreError(cannot + "cannot rename a file in " + folder + ": " + errnoText(errno));
+  if (const int error = removeFile(probe_name); error != 0)
+    throw MapStoreError(cannot + "cannot remove a file in " + folder + " (" + probe_name + "): " + errnoText(error));
+}
+
 void MapStore::save(const std::filesystem::path& path, const TopologyParticleFilter& filter,
                     std::string_view application_data, const MapFileOps& ops) {
   writeAtomically(path, encode(filter, application_data), ops);

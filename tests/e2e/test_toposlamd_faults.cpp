@@ -6,11 +6,15 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -40,11 +44,18 @@ std::string readText(const fs::path& path) {
   return text.str();
 }
 
-/// toposlamd started with `args` (after the binary), stdout and stderr to `log`.
-pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {}) {
+/// toposlamd started with `args` (after the binary), stdout and stderr to `log`; with a file-size limit
+/// (ulimit -f, bytes) when `file_size_limit` is not 0, and SIGXFSZ at its default as a shell leaves it.
+pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {},
+                  rlim_t file_size_limit = 0) {
   const pid_t pid = fork();
   if (pid == 0) {
     if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
+    if (file_size_limit > 0) {
+      const rlimit limit{file_size_limit, file_size_limit};
+      if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
+      signal(SIGXFSZ, SIG_DFL);
+    }
     const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1);
     dup2(fd, 2);
@@ -385,4 +396,93 @@ SCENARIO("GIVEN a map whose last frame is not in the folder any more WHEN toposl
   CHECK_THAT(log2, Catch::Contains("images: " + frames.string() + " has no file " + last_name) &&
                        Catch::Contains("starting from its first frame") &&
                        Catch::Contains("toposlamd: 8 frames published"));
+}
+
+// ---- a map known to be savable, every terminating signal, the settings a map records (issue 41) ---------
+
+SCENARIO("GIVEN a directory at the map path, or a folder where no file can be created WHEN toposlamd starts THEN "
+         "it exits 2 at once naming the problem, before any frame") {
+  const fs::path dir = freshDirectory("unsavable");
+  const fs::path frames = sampleFolder(dir, 3);
+  fs::path map;
+  std::string problem;
+  SECTION("a directory at the map path") {
+    map = dir / "map.tsm";
+    fs::create_directory(map);
+    problem = map.string() + " is a directory";
+  }
+  SECTION("a folder where no file can be created") {
+    // Root ignores permission bits; sysfs takes no new file, even from root.
+    fs::path folder = "/sys";
+    if (geteuid() != 0) {
+      folder = dir / "read-only";
+      fs::create_directory(folder);
+      fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec, fs::perm_options::replace);
+    }
+    map = folder / "map.tsm";
+    problem = "cannot create a file in " + folder.string();
+  }
+  const auto started = Clock::now();
+  const int code = runDaemon(dir / "run.log", daemonArgs(frames, map));
+  const double seconds = secondsSince(started);
+  const std::string log = readText(dir / "run.log");
+  INFO(log);
+  WARN("refused in " << seconds << " s");
+  CHECK(code == 2);
+  CHECK_THAT(log, Catch::Contains("toposlamd: error: the map " + map.string() + " could not be saved: " + problem));
+  CHECK_FALSE(Catch::Contains("toposlamd: source").match(log));  // nothing opened, no frame read
+  CHECK(seconds < 10.0);
+  std::error_code ignored;
+  fs::permissions(dir / "read-only", fs::perms::owner_all, fs::perm_options::replace, ignored);
+}
+
+SCENARIO("GIVEN a file-size limit smaller than the map WHEN toposlamd saves it THEN every save fails with EFBIG, "
+         "is retried and reported, the process is not killed by SIGXFSZ, and the previous map is kept") {
+  const fs::path dir = freshDirectory("file-size-limit");
+  const fs::path frames = sampleFolder(dir, 12);
+  const fs::path map = dir / "map.tsm";
+  REQUIRE(runDaemon(dir / "run1.log", daemonArgs(frames, map)) == 0);
+  const std::string before = readText(map);
+  // Half the map: every save of it fails (a snapshot of the resumed map is a little smaller than the file).
+  // The log file is limited too: it stays far below.
+  const rlim_t limit = before.size() / 2;
+  INFO("map " << before.size() << " bytes, limit " << limit);
+  REQUIRE(before.size() > 20000);
+  std::ofstream(dir / "periodic.yaml") << "map:\n  save_period_s: 1\n";
+  std::vector<std::string> args = daemonArgs(frames, map);
+  args[1] += "?rate=4";  // 12 frames in 3 s of real time: periodic saves on the way
+  args.insert(args.end(), {"--source-from-start", "--config", (dir / "periodic.yaml").string()});
+  const int code = waitForExit(startDaemon(dir / "run2.log", args, {}, limit), 60.0);
+  const std::string log = readText(dir / "run2.log");
+  INFO(log);
+  CHECK(code == 1);  // the final save failed: an error, not death by SIGXFSZ (153)
+  CHECK_THAT(log, Catch::Contains("periodic map save to " + map.string() + " failed (1 in a row; retried, the run goes on)") &&
+                      Catch::Contains(std::strerror(EFBIG)) && Catch::Contains("trying the map save again in") &&
+                      Catch::Contains("files are limited to " + std::to_string(limit) + " bytes here (ulimit -f)") &&
+                      Catch::Contains("saving the map to " + map.string() + " failed 3 times"));
+  CHECK(readText(map) == before);  // the previous map, whole
+  CHECK(countPrefix(dir, ".map.tsm.") == 0);
+}
+
+SCENARIO("GIVEN a running toposlamd WHEN it gets any signal that would end it and can be caught THEN it saves the "
+         "map and exits 0; SIGXFSZ is ignored") {
+  const fs::path dir = freshDirectory("signals");
+  const fs::path map = dir / "map.tsm";
+  const std::vector<std::string> args = {"--source", "sim:office?route=loop2&size=160x120&rate=10", "--map",
+                                         map.string(), "--lcm-url", "memq://"};
+  for (const int s : {SIGXCPU, SIGPWR, SIGVTALRM, SIGPROF, SIGSYS, SIGIO, SIGSTKFLT, SIGRTMIN, SIGRTMIN + 5, SIGRTMAX}) {
+    const fs::path log_path = dir / ("signal-" + std::to_string(s) + ".log");
+    const pid_t pid = startDaemon(log_path, args);
+    REQUIRE(pid > 0);
+    REQUIRE(waitForLog(log_path, "toposlamd: running", 30.0));
+    fs::remove(map);
+    kill(pid, SIGXFSZ);  // ignored: its default would end the process at once (exit 153)
+    kill(pid, s);
+    const int code = waitForExit(pid, 30.0);
+    const std::string log = readText(log_path);
+    INFO("signal " << s << " (" << strsignal(s) << ")\n" << log);
+    CHECK(code == 0);
+    CHECK_THAT(log, Catch::Contains(std::string(strsignal(s)) + " received: finishing the filter step"));
+    CHECK(fs::exists(map));
+  }
 }

@@ -602,3 +602,55 @@ TEST_CASE("GIVEN a map WHEN the rename that puts the new map in place fails THEN
   CHECK(readAll(path) == current);
   CHECK(namesIn(temp.path) == std::vector<std::string>{"map.tsm"});
 }
+
+TEST_CASE("GIVEN map paths that cannot be saved WHEN checked at start THEN the problem is named, and a good path "
+          "leaves nothing behind",
+          "[topology][map][reliability]") {
+  const TempFolder temp("writable");
+  const fs::path& dir = temp.path;
+  auto refusal = [](const fs::path& path) -> std::string {
+    try {
+      MapStore::checkWritable(path);
+    } catch (const MapStoreError& e) {
+      return e.what();
+    }
+    return {};
+  };
+  SECTION("a good folder: the probe file is made and removed") {
+    CHECK(refusal(dir / "map.tsm").empty());
+    CHECK(filesIn(dir) == 0);
+  }
+  SECTION("a directory at the map path") {
+    fs::create_directory(dir / "map.tsm");
+    CHECK_THAT(refusal(dir / "map.tsm"), Catch::Contains((dir / "map.tsm").string() + " is a directory"));
+  }
+  SECTION("a directory at the .prev path") {
+    fs::create_directory(dir / "map.tsm.prev");
+    CHECK_THAT(refusal(dir / "map.tsm"), Catch::Contains((dir / "map.tsm.prev").string() + " is a directory"));
+  }
+  SECTION("a folder that does not exist") {
+    CHECK_THAT(refusal(dir / "missing" / "map.tsm"), Catch::Contains("folder " + (dir / "missing").string() +
+                                                                     " does not exist"));
+  }
+  SECTION("a folder where no file can be created") {
+    // Root ignores permission bits; sysfs takes no new file, even from root.
+    fs::path folder = "/sys";
+    if (geteuid() != 0) {
+      folder = dir / "read-only";
+      fs::create_directory(folder);
+      fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
+    }
+    CHECK_THAT(refusal(folder / "map.tsm"), Catch::Contains("cannot create a file in " + folder.string()));
+    std::error_code ignored;  // so that the folder can be removed (root: there is none)
+    fs::permissions(dir / "read-only", fs::perms::owner_all, fs::perm_options::replace, ignored);
+  }
+  SECTION("a full disk") {
+    try {
+      MapStore::checkWritable(dir / "map.tsm", FullDisk(0));
+      FAIL("not refused");
+    } catch (const MapStoreError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("cannot write a file in") && Catch::Contains(std::strerror(ENOSPC)));
+    }
+    CHECK(filesIn(dir) == 0);
+  }
+}

@@ -612,6 +612,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
     std::vector<std::string> uris;
     for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
     writeSources(out_dir, uris);
+  try {
+    MapStore::checkWritable(map_path);  // found out now, not after the run
+  } catch (const MapStoreError& e) {
+    throw ConfigError(std::string("map: ") + e.what());
+  }
   }
   const std::vector<FrameRecord> frame_rows = frameRowsWithLoopClosures(
       runner, place_nodes, traversals.frame_fingerprints, similarity, evidence.frame_revisits, o.loop_min_gap);

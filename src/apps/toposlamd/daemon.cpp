@@ -1,11 +1,18 @@
 // toposlamd's body; see daemon.hpp. Signals are blocked in every thread (the mask is set before any thread
 // exists, threads inherit it) and taken synchronously by the main thread (waitForSignal, platform/os), so no work
 // happens in a signal handler:
-//   SIGTERM, SIGINT, SIGHUP, SIGQUIT   finish the filter step in progress, save the map, exit 0
+//   SIGTERM, SIGINT, SIGHUP, SIGQUIT and every other signal that would end the process and can be taken
+//   (SIGXCPU, SIGPWR, SIGVTALRM, SIGPROF, SIGIO, SIGSYS, SIGSTKFLT, SIGRTMIN..SIGRTMAX; platform/os,
+//   catchableTerminatingSignals)
+//                                      finish the filter step in progress, save the map, exit 0
 //   SIGUSR1, SIGUSR2, SIGALRM          logged and otherwise ignored (their default would kill the daemon
 //                                      without a final save)
-//   SIGPIPE                            ignored: a write to a closed pipe (a log reader gone) fails with
-//                                      EPIPE, which the writers treat as a failed write, not as the end
+//   SIGPIPE, SIGXFSZ                   ignored: a write to a closed pipe (a log reader gone) fails with
+//                                      EPIPE, one beyond the file-size limit (ulimit -f) with EFBIG, which
+//                                      the writers treat as a failed write (a map save is retried, the
+//                                      previous map kept), not as the end
+//   SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGABRT, SIGKILL, SIGSTOP: their default (nothing trusted to
+//                                      save, or nothing to catch)
 #include "daemon.hpp"
 
 #include <algorithm>
@@ -33,6 +40,7 @@
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
+#include "toposlam/platform/file_system.hpp"
 #include "toposlam/platform/signal_mask.hpp"
 #include "toposlam/platform/systemd_notifier.hpp"
 #include "toposlam/platform/thread_os.hpp"
@@ -42,18 +50,32 @@ namespace toposlam::daemon {
 
 namespace {
 
-constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT};
+/// Taken by the main thread, logged and otherwise ignored; every other signal it takes stops the daemon.
 constexpr int kIgnoredSignals[] = {SIGUSR1, SIGUSR2, SIGALRM};
 
+/// Ignored by the process: the write that raised one fails instead (EPIPE, EFBIG).
+const std::vector<int> kWriteSignals = {SIGPIPE, SIGXFSZ};
 bool isStopSignal(int signal) {
-  return std::find(std::begin(kStopSignals), std::end(kStopSignals), signal) != std::end(kStopSignals);
+  return signal != 0 &&
+         std::find(std::begin(kIgnoredSignals), std::end(kIgnoredSignals), signal) == std::end(kIgnoredSignals);
 }
 
-/// Every signal the main thread takes with waitForSignal (stop and ignored ones).
-std::vector<int> handledSignalNumbers() {
-  std::vector<int> signals(std::begin(kStopSignals), std::end(kStopSignals));
-  signals.insert(signals.end(), std::begin(kIgnoredSignals), std::end(kIgnoredSignals));
-  return signals;
+/// Every signal the main thread takes with waitForSignal (stop and ignored ones): every signal that would end
+/// the process and can be caught.
+std::vector<int> handledSignalNumbers() { return catchableTerminatingSignals(); }
+
+/// Proves at start that the map can be saved, before any frame (MapStore::checkWritable, exit 2 otherwise),
+/// and says when a file-size limit may stop a later save.
+void checkMapSavable(const std::string& path) {
+  if (path.empty()) return;
+  MapStore::checkWritable(path);
+  if (const std::uint64_t limit = fileSizeLimitBytes(); limit > 0) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    spdlog::warn("toposlamd: files are limited to {} bytes here (ulimit -f){}: a map save beyond it fails (EFBIG), "
+                 "is retried and reported, and the previous map is kept", limit,
+                 ec ? std::string() : "; the map " + path + " is " + std::to_string(size) + " bytes");
+  }
 }
 
 /// The fingerprint stage's pool threads (tsl-vpack-1, ...) take the fingerprint thread's scheduling from
@@ -233,8 +255,8 @@ std::string resolveMapPath(const std::string& path) {
 
 int runDaemon(const DaemonConfig& config) {
   const std::vector<int> signals = handledSignalNumbers();
-  blockSignals(signals);  // before any thread exists: all inherit it
-  std::signal(SIGPIPE, SIG_IGN);                  // EPIPE instead of death on a closed log pipe
+  blockSignals(signals);        // before any thread exists: all inherit it
+  ignoreSignals(kWriteSignals);  // EPIPE instead of death on a closed log pipe, EFBIG beyond ulimit -f
 
   SystemdNotifier notifier;
   SteadyClock clock;
@@ -294,6 +316,8 @@ int runDaemon(const DaemonConfig& config) {
     }
   }
 
+  // A map that cannot be saved is found out now, not after a session of mapping.
+  checkMapSavable(map_config.path);
   const double watchdog_s = config.watchdog.enabled ? notifier.watchdogPeriodSeconds() : 0.0;
   if (!waitForNetwork(config, signals, notifier, watchdog_s, clock)) return 0;
 
@@ -392,6 +416,8 @@ int runDaemon(const DaemonConfig& config) {
   if (const std::int64_t unsent = notifier.droppedNotifications(); unsent > 0)
     spdlog::warn("toposlamd: {} service notifications found systemd's notify socket full and were dropped", unsent);
   if (!error.empty()) {
+    } else if (signal != 0 && stopping) {
+      spdlog::info("toposlamd: {} received while stopping: the map is being saved", strsignal(signal));
     notifier.status("failed: " + error);
     spdlog::error("toposlamd: {}", error);
     return 1;
