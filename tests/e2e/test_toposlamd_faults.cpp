@@ -400,6 +400,61 @@ SCENARIO("GIVEN a map whose last frame is not in the folder any more WHEN toposl
 
 // ---- a map known to be savable, every terminating signal, the settings a map records (issue 41) ---------
 
+namespace {
+
+/// A shell command's exit code (its output to `log`).
+int runCommand(const std::string& command, const fs::path& log) {
+  const int status = std::system((command + " >" + log.string() + " 2>&1").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+/// zlib's CRC-32 (the checksum of map format 3 and 4), bit by bit: the test has no zlib of its own.
+std::uint32_t crc32Of(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (const char ch : bytes) {
+    crc ^= static_cast<unsigned char>(ch);
+    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return crc ^ 0xFFFFFFFFu;
+}
+
+std::uint64_t readLe(const std::string& bytes, std::size_t at, int size) {
+  std::uint64_t value = 0;
+  for (int i = 0; i < size; ++i) value |= std::uint64_t{static_cast<unsigned char>(bytes[at + i])} << (8 * i);
+  return value;
+}
+
+void putLe(std::string& out, std::uint64_t value, int size) {
+  for (int i = 0; i < size; ++i) out.push_back(static_cast<char>((value >> (8 * i)) & 0xff));
+}
+
+/// The map file rewritten as format 3 wrote it: the same filter and application data, its settings only the
+/// keypoints and the source (what maps recorded before every decision setting was).
+std::string asFormat3(const std::string& map) {
+  constexpr std::size_t kHeader = 32;
+  std::size_t at = kHeader;
+  std::string payload;
+  for (int field = 0; field < 2; ++field) {  // bytes(filter state), bytes(application data)
+    const std::size_t size = static_cast<std::size_t>(readLe(map, at, 8));
+    payload += map.substr(at, 8 + size);
+    at += 8 + size;
+  }
+  std::istringstream lines(map.substr(at + 8, static_cast<std::size_t>(readLe(map, at, 8))));
+  std::string settings;
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("keypoints=", 0) == 0 || line.rfind("source=", 0) == 0) settings += line + "\n";
+  putLe(payload, settings.size(), 8);
+  payload += settings;
+  std::string out = map.substr(0, 8);
+  putLe(out, 3, 4);
+  putLe(out, 0, 4);
+  putLe(out, payload.size(), 8);
+  putLe(out, crc32Of(payload), 8);
+  return out + payload;
+}
+
+}  // namespace
+
 SCENARIO("GIVEN a directory at the map path, or a folder where no file can be created WHEN toposlamd starts THEN "
          "it exits 2 at once naming the problem, before any frame") {
   const fs::path dir = freshDirectory("unsavable");
@@ -484,5 +539,53 @@ SCENARIO("GIVEN a running toposlamd WHEN it gets any signal that would end it an
     CHECK(code == 0);
     CHECK_THAT(log, Catch::Contains(std::string(strsignal(s)) + " received: finishing the filter step"));
     CHECK(fs::exists(map));
+  }
+}
+
+SCENARIO("GIVEN a map made by `toposlam map --preset thesis` WHEN the default toposlamd resumes it THEN it is refused "
+         "naming the settings that differ, unless map.resume_other_settings; a map of format 3 is resumed with a word") {
+  const fs::path dir = freshDirectory("thesis-settings");
+  const fs::path frames = sampleFolder(dir, 12);
+  const std::string source = "images:" + frames.string();
+  REQUIRE(runCommand(std::string(TOPOSLAM_CLI_BINARY) + " map --preset thesis --quiet " + source + " --out " +
+                         (dir / "thesis").string(), dir / "map.log") == 0);
+  const fs::path map = dir / "thesis" / "map.tsm";
+  const std::string thesis_map = readText(map);
+  std::vector<std::string> args = daemonArgs(frames, map);
+
+  const int code = runDaemon(dir / "default.log", args);
+  const std::string log = readText(dir / "default.log");
+  {
+    INFO(log);
+    CHECK(code == 2);
+    CHECK_THAT(log, Catch::Contains("toposlamd: error: the map " + map.string() + " was made with ") &&
+                        Catch::Contains("segmentation.window=25") && Catch::Contains("topology.likelihood=absolute") &&
+                        Catch::Contains("fingerprint.keypoints.orb_levels=") &&
+                        Catch::Contains("but this run uses ") && Catch::Contains("segmentation.window=100") &&
+                        Catch::Contains("--resume-other-settings continues it with this run's settings"));
+    CHECK(readText(map) == thesis_map);  // nothing moved or overwritten
+  }
+
+  // Told to, it continues, naming what differs.
+  args.push_back("--resume-other-settings");
+  {
+    const int resumed = runDaemon(dir / "other.log", args);
+    const std::string other = readText(dir / "other.log");
+    INFO(other);
+    CHECK(resumed == 0);
+    CHECK_THAT(other, Catch::Contains("was made with other settings; continuing it with this run's") &&
+                          Catch::Contains("segmentation.window=25 (now 100)") && Catch::Contains("resumed the map"));
+  }
+
+  // A map of format 3 records the keypoints and the source only: it loads, with a word, and is continued.
+  std::ofstream(map, std::ios::binary | std::ios::trunc) << asFormat3(thesis_map);
+  args.pop_back();
+  {
+    const int old = runDaemon(dir / "format3.log", args);
+    const std::string old_log = readText(dir / "format3.log");
+    INFO(old_log);
+    CHECK(old == 0);
+    CHECK_THAT(old_log, Catch::Contains("records none of the") && Catch::Contains("made by an older toposlam") &&
+                            Catch::Contains("resumed the map " + map.string()));
   }
 }

@@ -406,9 +406,11 @@ TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run T
   CHECK_THAT(MapStore::checkSettings(loaded.settings, fingerprintMapSettings(sift), path.string()),
              Catch::Contains(path.string()) && Catch::Contains("keypoints=orb") && Catch::Contains("keypoints=sift"));
 
-  SECTION("a version-2 map (FNV-1a checksum) still loads; version 3 carries zlib's CRC-32") {
-    const std::string v3 = MapStore::encode(*filter, "data", fingerprintMapSettings(orb));
-    REQUIRE(v3[8] == 3);
+  SECTION("a version-2 map (FNV-1a checksum) still loads; versions 3 and 4 carry zlib's CRC-32") {
+    std::string v3 = MapStore::encode(*filter, "data", fingerprintMapSettings(orb));
+    REQUIRE(v3[8] == 4);
+    v3[8] = 3;  // the same layout: version 4 only records more settings
+    CHECK(MapStore::decode(v3, sim).settings == MapSettings{{"keypoints", "orb"}});
     const std::string payload = v3.substr(32);
     std::string v2 = v3.substr(0, 8);
     v2 += std::string("\x02\0\0\0\0\0\0\0", 8);

@@ -11,7 +11,10 @@
 // where bytes(x) = u64 size + x. The application data is opaque to MapStore (the `map` command keeps
 // its place/frame bookkeeping there). The settings are "key=value" lines that decide whether a map can
 // be continued by a run (the keypoint backend: ORB descriptors mean nothing to a SIFT run; the source,
-// kMapSourceKey: a simulated office is no part of the robot's real map); checkSettings() compares them.
+// kMapSourceKey: a simulated office is no part of the robot's real map; from version 4, every config key
+// that changes what the mapping decides, by its path: "segmentation.window=25"); checkSettings() compares
+// them. Version 4 differs from 3 only in what the settings hold: a reader of 3 reads it, and a map of
+// version 2 or 3 still loads (its settings name the keypoints and the source only).
 //
 // This header is the format and the policies, with no I/O (an algorithm touches no file): encode()
 // and decode() turn a filter into a file image and back; MapFramingCheck verifies a file's framing piece
@@ -51,7 +54,7 @@
 
 namespace toposlam {
 
-inline constexpr std::uint32_t kMapFormatVersion = 3;
+inline constexpr std::uint32_t kMapFormatVersion = 4;
 /// Default cap on a map file's size (bytes): a bigger file is refused before it is read. A map of 100
 /// places with 500 particles is about 1 MB.
 inline constexpr std::uint64_t kDefaultMaxMapBytes = 256ull << 20;
