@@ -256,9 +256,10 @@ MapSettings mapSettingsOf(const DaemonConfig& config) {
 /// Returns true when the map was made from another source.
 bool checkResumable(const MapSettings& recorded, const MapSettings& current, const MapConfig& map,
                     const std::string& name) {
+  const MapSettings decision_keys = mapDecisionSettings(DaemonConfig());
   const bool other_source = settingDiffers(recorded, current, kMapSourceKey);
   std::vector<std::string> other_settings, unrecorded;
-  for (const auto& [key, value] : mapDecisionSettings(DaemonConfig())) {
+  for (const auto& [key, value] : decision_keys) {
     if (recorded.count(key) == 0)
       unrecorded.push_back(key);
     else if (settingDiffers(recorded, current, key))
@@ -267,7 +268,7 @@ bool checkResumable(const MapSettings& recorded, const MapSettings& current, con
   MapSettings compared = current;
   if (map.resume_other_source) compared.erase(kMapSourceKey);
   if (map.resume_other_settings)
-    for (const auto& [key, value] : mapDecisionSettings(DaemonConfig())) compared.erase(key);
+    for (const auto& [key, value] : decision_keys) compared.erase(key);
   if (const std::string refusal = MapStore::checkSettings(recorded, compared, name); !refusal.empty()) {
     std::string hint;
     if (other_source && !map.resume_other_source)
@@ -288,8 +289,7 @@ bool checkResumable(const MapSettings& recorded, const MapSettings& current, con
   if (!unrecorded.empty())
     spdlog::warn("toposlamd: the map {} records {} of the {} settings a map made now records (it was made by an "
                  "older toposlam): they cannot be compared; continuing it with this run's settings", name,
-                 unrecorded.size() == mapDecisionSettings(DaemonConfig()).size() ? "none" : "not all",
-                 mapDecisionSettings(DaemonConfig()).size());
+                 unrecorded.size() == decision_keys.size() ? "none" : "not all", decision_keys.size());
   return other_source;
 }
 
