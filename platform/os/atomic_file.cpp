@@ -12,6 +12,7 @@ namespace toposlam {
 
 long FileWriteOps::write(int fd, const void* data, std::size_t size) const { return ::write(fd, data, size); }
 int FileWriteOps::fsync(int fd) const { return ::fsync(fd); }
+int FileWriteOps::rename(const char* from, const char* to) const { return ::rename(from, to); }
 
 AtomicFileWrite::AtomicFileWrite(std::filesystem::path target, std::string infix)
     : target_(std::move(target)),
@@ -62,8 +63,8 @@ int AtomicFileWrite::close() {
   return ::close(fd) != 0 ? errno : 0;
 }
 
-int AtomicFileWrite::replaceTarget() {
-  if (::rename(temporary_.c_str(), target_.c_str()) != 0) return errno;
+int AtomicFileWrite::replaceTarget(const FileWriteOps& ops) {
+  if (ops.rename(temporary_.c_str(), target_.c_str()) != 0) return errno;
   replaced_ = true;
   return 0;
 }

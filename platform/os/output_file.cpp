@@ -130,7 +130,7 @@ void OutputFile::commit() {
     failCommit(target_.string() + ": write failed: " + std::strerror(buffer_->error()) +
                (atomic_ != nullptr ? " (the file was not written)" : ""));
   if (atomic_ != nullptr) {
-    if (const int error = atomic_->replaceTarget(); error != 0)
+    if (const int error = atomic_->replaceTarget(buffer_->ops()); error != 0)
       failCommit(target_.string() + ": cannot replace it: " + std::strerror(error));
     if (const int error = atomic_->syncFolder(buffer_->ops()); error != 0)
       failCommit(target_.string() + ": written, but its folder could not be flushed (the new file may not survive a "

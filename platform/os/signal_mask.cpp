@@ -38,6 +38,22 @@ int waitForSignal(const std::vector<int>& signals, double seconds) {
   return signal > 0 ? signal : 0;
 }
 
+std::vector<int> catchableTerminatingSignals() {
+  std::vector<int> signals = {SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGUSR1, SIGUSR2, SIGALRM, SIGXCPU,
+                              SIGVTALRM, SIGPROF, SIGIO, SIGPWR, SIGSYS, SIGSTKFLT};
+  for (int s = SIGRTMIN; s <= SIGRTMAX; ++s) signals.push_back(s);
+  return signals;
+}
+
+int ignoreSignals(const std::vector<int>& signals) {
+  struct sigaction action {};
+  action.sa_handler = SIG_IGN;
+  sigemptyset(&action.sa_mask);
+  for (int s : signals)
+    if (sigaction(s, &action, nullptr) != 0) return errno;
+  return 0;
+}
+
 int catchSignals(const std::vector<int>& signals, void (*handler)(int)) {
   struct sigaction action {};
   action.sa_handler = handler;

@@ -220,6 +220,12 @@ std::vector<ConfigKey> makeKeys() {
                    "a map records its source (v4l2:/dev/video0, sim:office, ...); one made from another source "
                    "is refused (exit 2) unless this is true")
                   .withOption("--resume-other-source", true));
+  k.push_back(flag("map.resume_other_settings", AT(map.resume_other_settings), false,
+                   "a map records every setting that changes what the mapping decides (fingerprint, similarity, "
+                   "segmentation, topology); one made with other values is refused (exit 2, naming them) unless "
+                   "this is true. The keypoint backend is never waived; the filter's own settings (particles, "
+                   "likelihood, ...) always come from the map")
+                  .withOption("--resume-other-settings", true));
   k.push_back(flag("map.source_from_start", AT(map.source_from_start), false,
                    "a map made from a folder of images records the last frame it holds, and a restart from "
                    "the same folder continues after that frame (each frame is mapped once); true reads the "
@@ -546,6 +552,24 @@ std::vector<ConfigKey> makeKeys() {
 
 #undef AT
 
+/// Marks the keys a map records (ConfigKey::recorded_in_map): every key of the stages that decide (the
+/// fingerprint, similarity, segmentation and topology sections) except those that only say how the work
+/// is spread or what is published, the keypoint backend (recorded under its older name "keypoints",
+/// fingerprintMapSettings, so that maps made before every setting was recorded compare with it), and the
+/// seed (a resumed map continues its own random state).
+void markMapSettings(std::vector<ConfigKey>& keys) {
+  const std::vector<std::string> sections = {"fingerprint.", "similarity.", "segmentation.", "topology."};
+  const std::vector<std::string> not_recorded = {"fingerprint.workers", "fingerprint.keypoints.backend",
+                                                 "topology.seed", "topology.slice_items", "topology.alternatives"};
+  for (ConfigKey& key : keys) {
+    bool in_section = false;
+    for (const std::string& section : sections) in_section = in_section || key.path.rfind(section, 0) == 0;
+    bool excluded = false;
+    for (const std::string& path : not_recorded) excluded = excluded || key.path == path;
+    key.recorded_in_map = in_section && !excluded;
+  }
+}
+
 }  // namespace
 
 std::string ConfigKey::rangeText() const {
@@ -642,8 +666,19 @@ double ConfigKey::defaultNumber() const {
 }
 
 const std::vector<ConfigKey>& daemonConfigKeys() {
-  static const std::vector<ConfigKey> keys = makeKeys();
+  static const std::vector<ConfigKey> keys = [] {
+    std::vector<ConfigKey> k = makeKeys();
+    markMapSettings(k);
+    return k;
+  }();
   return keys;
+}
+
+std::map<std::string, std::string> mapDecisionSettings(const DaemonConfig& config) {
+  std::map<std::string, std::string> settings;
+  for (const ConfigKey& key : daemonConfigKeys())
+    if (key.recorded_in_map) settings[key.path] = key.yamlText(key.get(config));
+  return settings;
 }
 
 const std::vector<ConfigSection>& daemonConfigSections() {

@@ -116,19 +116,60 @@ void MapStore::writeAtomically(const std::filesystem::path& path, std::string_vi
     throw MapStoreError("cannot flush map " + path.string() + " to disk: " + errnoText(error) + unchanged);
   if (const int error = write.close(); error != 0)
     throw MapStoreError("cannot close map " + path.string() + ": " + errnoText(error) + unchanged);
-  // Keep the file being replaced as <path>.prev (best effort: a hard link, no copy), but only when its
-  // framing verifies: a damaged file must not push the last good map out of <path>.prev.
-  if (fileVerifies(path)) {
-    const std::string previous_temp = previousTemporaryPath(write.temporaryPath());
-    if (linkFile(path, previous_temp) == 0 && renameFile(previous_temp, previousPath(path)) != 0)
-      removeFile(previous_temp);
+  // The file being replaced becomes <path>.prev by a rename, then the new file takes <path>: at every
+  // instant one of the two names holds a complete map, and they are never one file (a hard link made them
+  // one until the second rename, so a kill in between left no older map). Between the renames <path> is
+  // missing for a moment; recovery then loads <path>.prev. Only a file whose framing verifies is kept: a
+  // damaged file must not push the last good map out of <path>.prev.
+  const std::filesystem::path previous = previousPath(path);
+  const bool keep_previous = fileVerifies(path);
+  if (keep_previous && ops.rename(path.c_str(), previous.c_str()) != 0) {
+    throw MapStoreError("cannot keep map " + path.string() + " as " + previous.string() + ": " +
+                        errnoText(errno) + unchanged);
   }
-  if (const int error = write.replaceTarget(); error != 0)
+  if (const int error = write.replaceTarget(ops); error != 0) {
+    // Put the map back under its own name (the older .prev went with the first rename).
+    if (keep_previous && ops.rename(previous.c_str(), path.c_str()) != 0) {
+      throw MapStoreError("cannot replace map " + path.string() + ": " + errnoText(error) +
+                          " (the previous map is kept as " + previous.string() + ")");
+    }
     throw MapStoreError("cannot replace map " + path.string() + ": " + errnoText(error) + unchanged);
+  }
   if (const int error = write.syncFolder(ops); error != 0) {
     throw MapStoreError("map " + path.string() +
                         " written but its directory could not be flushed: " + errnoText(error));
   }
+}
+
+void MapStore::checkWritable(const std::filesystem::path& path, const MapFileOps& ops) {
+  const std::string folder = folderOf(path).string();
+  const std::string cannot = "the map " + path.string() + " could not be saved: ";
+  std::error_code ec;
+  for (const std::filesystem::path& name : {path, previousPath(path)}) {
+    const std::filesystem::file_status status = std::filesystem::symlink_status(name, ec);
+    if (status.type() == std::filesystem::file_type::directory)
+      throw MapStoreError(cannot + name.string() + " is a directory; remove it or choose another map path");
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+        !std::filesystem::is_symlink(status))
+      throw MapStoreError(cannot + name.string() + " is not a regular file; remove it or choose another map path");
+  }
+  if (!std::filesystem::is_directory(folderOf(path), ec))
+    throw MapStoreError(cannot + "its folder " + folder + " does not exist (or is not a folder)");
+  // What a save does, on a probe file beside the map: create, write, fsync, rename; then remove it.
+  AtomicFileWrite probe(path, kTemporaryInfix);
+  if (const int error = probe.create(); error != 0)
+    throw MapStoreError(cannot + "cannot create a file in " + folder + ": " + errnoText(error));
+  const std::string probe_name = probePath(probe.temporaryPath());
+  if (const int error = probe.write("toposlam map save probe\n", ops); error != 0)
+    throw MapStoreError(cannot + "cannot write a file in " + folder + ": " + errnoText(error));
+  if (const int error = probe.sync(ops); error != 0)
+    throw MapStoreError(cannot + "cannot flush a file in " + folder + " to disk: " + errnoText(error));
+  if (const int error = probe.close(); error != 0)
+    throw MapStoreError(cannot + "cannot close a file in " + folder + ": " + errnoText(error));
+  if (ops.rename(probe.temporaryPath().c_str(), probe_name.c_str()) != 0)
+    throw MapStoreError(cannot + "cannot rename a file in " + folder + ": " + errnoText(errno));
+  if (const int error = removeFile(probe_name); error != 0)
+    throw MapStoreError(cannot + "cannot remove a file in " + folder + " (" + probe_name + "): " + errnoText(error));
 }
 
 void MapStore::save(const std::filesystem::path& path, const TopologyParticleFilter& filter,

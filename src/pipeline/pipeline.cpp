@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iterator>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include <opencv2/core/utility.hpp>
@@ -18,6 +19,13 @@ namespace toposlam {
 namespace {
 
 constexpr std::chrono::milliseconds kPollPeriod{100};  // how often an idle thread wakes to beat
+// A failed periodic map write is retried after kFirstSaveRetry_s, then after twice as long each time, up to
+// map.save_period_s (kMaxSaveRetry_s when there are no periodic saves), unless a newer snapshot comes first.
+constexpr double kFirstSaveRetry_s = 1.0;
+constexpr double kMaxSaveRetry_s = 60.0;
+// The final save (at stop) is tried this many times, kFinalSaveRetry_s apart, before it is an error.
+constexpr int kFinalSaveAttempts = 3;
+constexpr std::chrono::milliseconds kFinalSaveRetry{500};
 const char* const kStageNames[] = {"capture", "fingerprint", "segmentation", "topology", "publisher"};
 
 std::string rangeError(const std::string& key, double value, const char* range) {
@@ -90,7 +98,11 @@ std::string statusLine(const PipelineStatus& s) {
                 "%s: %.1f fps, latency p99 %.1f ms, %d places, map rev %lld, %lld dropped, %lld kept waits; %s",
                 s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
                 static_cast<long long>(s.frames_dropped), static_cast<long long>(s.queue_kept_waits), camera);
-  return text;
+  std::string line = text;
+  if (s.map_save_failures > 0)
+    line += "; map save failing (" + std::to_string(s.map_save_failures) + " in a row, retrying; the previous map is kept): " +
+            s.map_save_problem;
+  return line;
 }
 
 struct Pipeline::CapturedFrame {
@@ -370,23 +382,71 @@ void Pipeline::saveMap(bool final) {
     map_writes_->push(std::move(job));
 }
 
-void Pipeline::mapWriterLoop() {
-  // Encodes and writes snapshots with their fsync here, so neither a big map nor a slow disk holds up the
-  // topology thread.
-  while (std::optional<MapWrite> job = map_writes_->pop()) {
+bool Pipeline::writeMap(const MapWrite& job) {
+  const int attempts = job.final ? kFinalSaveAttempts : 1;
+  for (int attempt = 1;; ++attempt) {
     const double t0 = clock_.now();
     try {
-      job->snapshot->writeTo(map_.path);  // atomic by contract (MapStore: temporary file, fsync, rename)
+      job.snapshot->writeTo(map_.path);  // atomic by contract (MapStore: temporary file, fsync, rename)
       maps_saved_.fetch_add(1);
+      if (const std::int64_t failed = map_save_failures_.exchange(0); failed > 0)
+        spdlog::info("pipeline: the map saves to {} work again after {} failed", map_.path, failed);
       spdlog::info("pipeline: map saved to {} ({} bytes; snapshot {:.2f} ms in the topology thread, encode and write {:.2f} ms "
                    "in the map writer)",
-                   map_.path, job->snapshot->bytes(), job->snapshot_ms, (clock_.now() - t0) * 1e3);
+                   map_.path, job.snapshot->bytes(), job.snapshot_ms, (clock_.now() - t0) * 1e3);
+      return true;
     } catch (const std::exception& e) {
-      if (job->final)
-        recordError("saving the map to " + map_.path + " failed: " + e.what());
+      const std::int64_t failures = map_save_failures_.fetch_add(1) + 1;
+      {
+        std::lock_guard lock(status_mutex_);
+        map_save_problem_ = e.what();
+      }
+      if (attempt < attempts) {
+        spdlog::warn("pipeline: the final map save to {} failed ({} of {} attempts): {}", map_.path, attempt,
+                     attempts, e.what());
+        std::this_thread::sleep_for(kFinalSaveRetry * attempt);  // a back-off before trying again
+        continue;
+      }
+      if (job.final)
+        recordError("saving the map to " + map_.path + " failed " + std::to_string(attempts) + " times: " + e.what());
       else
-        spdlog::warn("pipeline: periodic map save to {} failed: {}", map_.path, e.what());
+        spdlog::warn("pipeline: periodic map save to {} failed ({} in a row; retried, the run goes on): {}", map_.path,
+                     failures, e.what());
+      return false;
     }
+  }
+}
+
+void Pipeline::mapWriterLoop() {
+  // Encodes and writes snapshots with their fsync here, so neither a big map nor a slow disk holds up the
+  // topology thread. A snapshot whose write failed (a full disk, a file-size limit) is written again after a
+  // growing wait, unless a newer snapshot comes first and takes its place; the run goes on meanwhile.
+  const double max_retry_s = map_.save_period_s > 0 ? map_.save_period_s : kMaxSaveRetry_s;
+  std::optional<MapWrite> failed;
+  double retry_s = kFirstSaveRetry_s;
+  for (;;) {
+    MapWrite job;
+    if (!failed) {
+      std::optional<MapWrite> next = map_writes_->pop();
+      if (!next) break;
+      job = std::move(*next);
+    } else {
+      const QueueWait wait = map_writes_->popFor(job, std::chrono::duration<double>(retry_s));
+      if (wait == QueueWait::Closed) {
+        spdlog::warn("pipeline: the map snapshot whose save to {} failed was not written (no final save came)", map_.path);
+        break;
+      }
+      if (wait == QueueWait::Timeout) job = *failed;
+    }
+    const bool retry = failed.has_value();
+    if (writeMap(job) || job.final) {
+      failed.reset();
+      retry_s = kFirstSaveRetry_s;
+      continue;
+    }
+    if (retry) retry_s = std::min(retry_s * 2.0, max_retry_s);
+    spdlog::info("pipeline: trying the map save again in {:.0f} s", retry_s);
+    failed = std::move(job);
   }
   map_writer_done_.set_value();
   finished_threads_.fetch_add(1);
@@ -510,6 +570,11 @@ StatusCounters Pipeline::statusCounters(std::int64_t published) const {
   c.place_queue_kept_waits = place_queue_kept_waits_.load();
   c.map_revision = map_revision_.load();
   c.maps_saved = maps_saved_.load();
+  c.map_save_failures = map_save_failures_.load();
+  if (c.map_save_failures > 0) {
+    std::lock_guard lock(status_mutex_);
+    c.map_save_problem = map_save_problem_;
+  }
   return c;
 }
 

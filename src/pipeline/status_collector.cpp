@@ -84,6 +84,8 @@ PipelineStatus StatusCollector::collect(double now_s, const std::string& state, 
   s.places = counters.places;
   s.map_revision = counters.map_revision;
   s.maps_saved = counters.maps_saved;
+  s.map_save_failures = counters.map_save_failures;
+  s.map_save_problem = counters.map_save_problem;
   s.state = state;
   for (auto& w : stage_ms_) w.clear();
   latency_ms_.clear();

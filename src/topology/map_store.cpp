@@ -226,7 +226,7 @@ std::string MapStore::checkSettings(const MapSettings& recorded, const MapSettin
 
 std::filesystem::path MapStore::previousPath(const std::filesystem::path& path) { return path.string() + ".prev"; }
 
-std::string MapStore::previousTemporaryPath(const std::string& temporary_path) { return temporary_path + ".prev"; }
+std::string MapStore::probePath(const std::string& temporary_path) { return temporary_path + ".probe"; }
 
 std::vector<std::filesystem::path> MapStore::recoveryCandidates(const std::filesystem::path& path) {
   return {path, previousPath(path)};
@@ -238,7 +238,8 @@ bool MapStore::isTemporaryOf(const std::filesystem::path& path, const std::strin
   prefix += kTemporaryInfix;
   if (file_name.rfind(prefix, 0) != 0) return false;
   std::string rest = file_name.substr(prefix.size());
-  if (rest.size() == 6 + 5 && rest.compare(6, 5, ".prev") == 0) rest.resize(6);
+  if (rest.size() == 6 + 5 && rest.compare(6, 5, ".prev") == 0) rest.resize(6);  // an older build's link
+  if (rest.size() == 6 + 6 && rest.compare(6, 6, ".probe") == 0) rest.resize(6);
   // mkstemp's six characters: letters and digits.
   return rest.size() == 6 && std::all_of(rest.begin(), rest.end(), [](char c) {
            return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');

@@ -247,6 +247,6 @@ SCENARIO("GIVEN a command-line value WHEN set by its key's path THEN it is read 
   for (const ConfigKey& key : daemonConfigKeys())
     if (!key.option.empty()) options.insert(key.option);
   CHECK(options == std::set<std::string>{"--source", "--log-level", "--lcm-url", "--map", "--no-map-load",
-                                         "--resume-other-source", "--source-from-start", "--save-period",
-                                         "--overflow", "--record"});
+                                         "--resume-other-source", "--resume-other-settings", "--source-from-start",
+                                         "--save-period", "--overflow", "--record"});
 }

@@ -6,11 +6,15 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -40,11 +44,18 @@ std::string readText(const fs::path& path) {
   return text.str();
 }
 
-/// toposlamd started with `args` (after the binary), stdout and stderr to `log`.
-pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {}) {
+/// toposlamd started with `args` (after the binary), stdout and stderr to `log`; with a file-size limit
+/// (ulimit -f, bytes) when `file_size_limit` is not 0, and SIGXFSZ at its default as a shell leaves it.
+pid_t startDaemon(const fs::path& log, const std::vector<std::string>& args, const fs::path& cwd = {},
+                  rlim_t file_size_limit = 0) {
   const pid_t pid = fork();
   if (pid == 0) {
     if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
+    if (file_size_limit > 0) {
+      const rlimit limit{file_size_limit, file_size_limit};
+      if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
+      signal(SIGXFSZ, SIG_DFL);
+    }
     const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1);
     dup2(fd, 2);
@@ -385,4 +396,196 @@ SCENARIO("GIVEN a map whose last frame is not in the folder any more WHEN toposl
   CHECK_THAT(log2, Catch::Contains("images: " + frames.string() + " has no file " + last_name) &&
                        Catch::Contains("starting from its first frame") &&
                        Catch::Contains("toposlamd: 8 frames published"));
+}
+
+// ---- a map known to be savable, every terminating signal, the settings a map records (issue 41) ---------
+
+namespace {
+
+/// A shell command's exit code (its output to `log`).
+int runCommand(const std::string& command, const fs::path& log) {
+  const int status = std::system((command + " >" + log.string() + " 2>&1").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+/// zlib's CRC-32 (the checksum of map format 3 and 4), bit by bit: the test has no zlib of its own.
+std::uint32_t crc32Of(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (const char ch : bytes) {
+    crc ^= static_cast<unsigned char>(ch);
+    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return crc ^ 0xFFFFFFFFu;
+}
+
+std::uint64_t readLe(const std::string& bytes, std::size_t at, int size) {
+  std::uint64_t value = 0;
+  for (int i = 0; i < size; ++i) value |= std::uint64_t{static_cast<unsigned char>(bytes[at + i])} << (8 * i);
+  return value;
+}
+
+void putLe(std::string& out, std::uint64_t value, int size) {
+  for (int i = 0; i < size; ++i) out.push_back(static_cast<char>((value >> (8 * i)) & 0xff));
+}
+
+/// The map file rewritten as format 3 wrote it: the same filter and application data, its settings only the
+/// keypoints and the source (what maps recorded before every decision setting was).
+std::string asFormat3(const std::string& map) {
+  constexpr std::size_t kHeader = 32;
+  std::size_t at = kHeader;
+  std::string payload;
+  for (int field = 0; field < 2; ++field) {  // bytes(filter state), bytes(application data)
+    const std::size_t size = static_cast<std::size_t>(readLe(map, at, 8));
+    payload += map.substr(at, 8 + size);
+    at += 8 + size;
+  }
+  std::istringstream lines(map.substr(at + 8, static_cast<std::size_t>(readLe(map, at, 8))));
+  std::string settings;
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("keypoints=", 0) == 0 || line.rfind("source=", 0) == 0) settings += line + "\n";
+  putLe(payload, settings.size(), 8);
+  payload += settings;
+  std::string out = map.substr(0, 8);
+  putLe(out, 3, 4);
+  putLe(out, 0, 4);
+  putLe(out, payload.size(), 8);
+  putLe(out, crc32Of(payload), 8);
+  return out + payload;
+}
+
+}  // namespace
+
+SCENARIO("GIVEN a directory at the map path, or a folder where no file can be created WHEN toposlamd starts THEN "
+         "it exits 2 at once naming the problem, before any frame") {
+  const fs::path dir = freshDirectory("unsavable");
+  const fs::path frames = sampleFolder(dir, 3);
+  fs::path map;
+  std::string problem;
+  SECTION("a directory at the map path") {
+    map = dir / "map.tsm";
+    fs::create_directory(map);
+    problem = map.string() + " is a directory";
+  }
+  SECTION("a folder where no file can be created") {
+    // Root ignores permission bits; sysfs takes no new file, even from root.
+    fs::path folder = "/sys";
+    if (geteuid() != 0) {
+      folder = dir / "read-only";
+      fs::create_directory(folder);
+      fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec, fs::perm_options::replace);
+    }
+    map = folder / "map.tsm";
+    problem = "cannot create a file in " + folder.string();
+  }
+  const auto started = Clock::now();
+  const int code = runDaemon(dir / "run.log", daemonArgs(frames, map));
+  const double seconds = secondsSince(started);
+  const std::string log = readText(dir / "run.log");
+  INFO(log);
+  WARN("refused in " << seconds << " s");
+  CHECK(code == 2);
+  CHECK_THAT(log, Catch::Contains("toposlamd: error: the map " + map.string() + " could not be saved: " + problem));
+  CHECK_FALSE(Catch::Contains("toposlamd: source").match(log));  // nothing opened, no frame read
+  CHECK(seconds < 10.0);
+  std::error_code ignored;
+  fs::permissions(dir / "read-only", fs::perms::owner_all, fs::perm_options::replace, ignored);
+}
+
+SCENARIO("GIVEN a file-size limit smaller than the map WHEN toposlamd saves it THEN every save fails with EFBIG, "
+         "is retried and reported, the process is not killed by SIGXFSZ, and the previous map is kept") {
+  const fs::path dir = freshDirectory("file-size-limit");
+  const fs::path frames = sampleFolder(dir, 12);
+  const fs::path map = dir / "map.tsm";
+  REQUIRE(runDaemon(dir / "run1.log", daemonArgs(frames, map)) == 0);
+  const std::string before = readText(map);
+  // Half the map: every save of it fails (a snapshot of the resumed map is a little smaller than the file).
+  // The log file is limited too: it stays far below.
+  const rlim_t limit = before.size() / 2;
+  INFO("map " << before.size() << " bytes, limit " << limit);
+  REQUIRE(before.size() > 20000);
+  std::ofstream(dir / "periodic.yaml") << "map:\n  save_period_s: 1\n";
+  std::vector<std::string> args = daemonArgs(frames, map);
+  args[1] += "?rate=4";  // 12 frames in 3 s of real time: periodic saves on the way
+  args.insert(args.end(), {"--source-from-start", "--config", (dir / "periodic.yaml").string()});
+  const int code = waitForExit(startDaemon(dir / "run2.log", args, {}, limit), 60.0);
+  const std::string log = readText(dir / "run2.log");
+  INFO(log);
+  CHECK(code == 1);  // the final save failed: an error, not death by SIGXFSZ (153)
+  CHECK_THAT(log, Catch::Contains("periodic map save to " + map.string() + " failed (1 in a row; retried, the run goes on)") &&
+                      Catch::Contains(std::strerror(EFBIG)) && Catch::Contains("trying the map save again in") &&
+                      Catch::Contains("files are limited to " + std::to_string(limit) + " bytes here (ulimit -f)") &&
+                      Catch::Contains("saving the map to " + map.string() + " failed 3 times"));
+  CHECK(readText(map) == before);  // the previous map, whole
+  CHECK(countPrefix(dir, ".map.tsm.") == 0);
+}
+
+SCENARIO("GIVEN a running toposlamd WHEN it gets any signal that would end it and can be caught THEN it saves the "
+         "map and exits 0; SIGXFSZ is ignored") {
+  const fs::path dir = freshDirectory("signals");
+  const fs::path map = dir / "map.tsm";
+  const std::vector<std::string> args = {"--source", "sim:office?route=loop2&size=160x120&rate=10", "--map",
+                                         map.string(), "--lcm-url", "memq://"};
+  for (const int s : {SIGXCPU, SIGPWR, SIGVTALRM, SIGPROF, SIGSYS, SIGIO, SIGSTKFLT, SIGRTMIN, SIGRTMIN + 5, SIGRTMAX}) {
+    const fs::path log_path = dir / ("signal-" + std::to_string(s) + ".log");
+    const pid_t pid = startDaemon(log_path, args);
+    REQUIRE(pid > 0);
+    REQUIRE(waitForLog(log_path, "toposlamd: running", 30.0));
+    fs::remove(map);
+    kill(pid, SIGXFSZ);  // ignored: its default would end the process at once (exit 153)
+    kill(pid, s);
+    const int code = waitForExit(pid, 30.0);
+    const std::string log = readText(log_path);
+    INFO("signal " << s << " (" << strsignal(s) << ")\n" << log);
+    CHECK(code == 0);
+    CHECK_THAT(log, Catch::Contains(std::string(strsignal(s)) + " received: finishing the filter step"));
+    CHECK(fs::exists(map));
+  }
+}
+
+SCENARIO("GIVEN a map made by `toposlam map --preset thesis` WHEN the default toposlamd resumes it THEN it is refused "
+         "naming the settings that differ, unless map.resume_other_settings; a map of format 3 is resumed with a word") {
+  const fs::path dir = freshDirectory("thesis-settings");
+  const fs::path frames = sampleFolder(dir, 12);
+  const std::string source = "images:" + frames.string();
+  REQUIRE(runCommand(std::string(TOPOSLAM_CLI_BINARY) + " map --preset thesis --quiet " + source + " --out " +
+                         (dir / "thesis").string(), dir / "map.log") == 0);
+  const fs::path map = dir / "thesis" / "map.tsm";
+  const std::string thesis_map = readText(map);
+  std::vector<std::string> args = daemonArgs(frames, map);
+
+  const int code = runDaemon(dir / "default.log", args);
+  const std::string log = readText(dir / "default.log");
+  {
+    INFO(log);
+    CHECK(code == 2);
+    CHECK_THAT(log, Catch::Contains("toposlamd: error: the map " + map.string() + " was made with ") &&
+                        Catch::Contains("segmentation.window=25") && Catch::Contains("topology.likelihood=absolute") &&
+                        Catch::Contains("fingerprint.keypoints.orb_levels=") &&
+                        Catch::Contains("but this run uses ") && Catch::Contains("segmentation.window=100") &&
+                        Catch::Contains("--resume-other-settings continues it with this run's settings"));
+    CHECK(readText(map) == thesis_map);  // nothing moved or overwritten
+  }
+
+  // Told to, it continues, naming what differs.
+  args.push_back("--resume-other-settings");
+  {
+    const int resumed = runDaemon(dir / "other.log", args);
+    const std::string other = readText(dir / "other.log");
+    INFO(other);
+    CHECK(resumed == 0);
+    CHECK_THAT(other, Catch::Contains("was made with other settings; continuing it with this run's") &&
+                          Catch::Contains("segmentation.window=25 (now 100)") && Catch::Contains("resumed the map"));
+  }
+
+  // A map of format 3 records the keypoints and the source only: it loads, with a word, and is continued.
+  std::ofstream(map, std::ios::binary | std::ios::trunc) << asFormat3(thesis_map);
+  args.pop_back();
+  {
+    const int old = runDaemon(dir / "format3.log", args);
+    const std::string old_log = readText(dir / "format3.log");
+    INFO(old_log);
+    CHECK(old == 0);
+    CHECK_THAT(old_log, Catch::Contains("records none of the") && Catch::Contains("made by an older toposlam") &&
+                            Catch::Contains("resumed the map " + map.string()));
+  }
 }

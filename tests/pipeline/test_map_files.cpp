@@ -2,6 +2,7 @@
 // atomic save, refusal of damaged / truncated / newer files, a full disk, recovery, the lock, orphans.
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <random>
 #include <filesystem>
 #include <fstream>
@@ -404,9 +406,11 @@ TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run T
   CHECK_THAT(MapStore::checkSettings(loaded.settings, fingerprintMapSettings(sift), path.string()),
              Catch::Contains(path.string()) && Catch::Contains("keypoints=orb") && Catch::Contains("keypoints=sift"));
 
-  SECTION("a version-2 map (FNV-1a checksum) still loads; version 3 carries zlib's CRC-32") {
-    const std::string v3 = MapStore::encode(*filter, "data", fingerprintMapSettings(orb));
-    REQUIRE(v3[8] == 3);
+  SECTION("a version-2 map (FNV-1a checksum) still loads; versions 3 and 4 carry zlib's CRC-32") {
+    std::string v3 = MapStore::encode(*filter, "data", fingerprintMapSettings(orb));
+    REQUIRE(v3[8] == 4);
+    v3[8] = 3;  // the same layout: version 4 only records more settings
+    CHECK(MapStore::decode(v3, sim).settings == MapSettings{{"keypoints", "orb"}});
     const std::string payload = v3.substr(32);
     std::string v2 = v3.substr(0, 8);
     v2 += std::string("\x02\0\0\0\0\0\0\0", 8);
@@ -482,4 +486,173 @@ TEST_CASE("GIVEN saves killed with SIGKILL at random moments WHEN the map is rec
   }
   // Some kills land inside a save (a temporary file left behind); how many depends on the machine's speed.
   WARN("orphaned temporary files removed after " << kRuns << " kills: " << orphans_removed);
+}
+
+namespace {
+
+/// Kills the process (SIGKILL, as kill -9 would) when a save makes its `kill_at`-th rename (1-based), before
+/// that rename happens: nothing after it runs, no destructor, no clean-up.
+class KillAtRename : public MapFileOps {
+ public:
+  explicit KillAtRename(int kill_at) : kill_at_(kill_at) {}
+  int rename(const char* from, const char* to) const override {
+    if (++renames_ == kill_at_) ::raise(SIGKILL);
+    return MapFileOps::rename(from, to);
+  }
+
+ private:
+  int kill_at_;
+  mutable int renames_ = 0;
+};
+
+/// The inode of `path`, or 0 when it does not exist.
+std::uintmax_t inodeOf(const fs::path& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uintmax_t>(st.st_ino) : 0;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a map and its .prev WHEN a save is killed before, between or after its two renames THEN map.tsm or "
+          ".prev is a complete map, they are never one file, and recovery loads the newest that was complete",
+          "[topology][map][reliability]") {
+  auto sim = placeSimilarity();
+  const TempFolder temp("kill-renames");
+  const fs::path& dir = temp.path;
+  const fs::path path = dir / "map.tsm";
+  const fs::path previous = dir / "map.tsm.prev";
+  const std::string older = MapStore::encode(*smallFilter(sim, 4), "older");
+  const std::string current = MapStore::encode(*smallFilter(sim, 8), "current");
+  const std::string next = MapStore::encode(*smallFilter(sim, 12), "next");
+  // kill_at 1: before the first rename (map -> .prev); 2: between the renames; 3: no kill (2 renames).
+  const int kill_at = GENERATE(1, 2, 3);
+  INFO("killed at rename " << kill_at);
+  MapStore::writeAtomically(path, older);
+  MapStore::writeAtomically(path, current);  // map.tsm = current, .prev = older
+  REQUIRE(readAll(previous) == older);
+  REQUIRE(inodeOf(path) != inodeOf(previous));
+
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    MapStore::writeAtomically(path, next, KillAtRename(kill_at));
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  CHECK(WIFSIGNALED(status) == (kill_at <= 2));
+
+  // At every instant one of the two names holds a complete map, and they are two files.
+  CHECK((MapStore::fileVerifies(path) || MapStore::fileVerifies(previous)));
+  if (fs::exists(path) && fs::exists(previous)) CHECK(inodeOf(path) != inodeOf(previous));
+  const std::string expected_map = kill_at == 1 ? current : kill_at == 2 ? "" : next;
+  const std::string expected_previous = kill_at == 1 ? older : current;
+  CHECK((fs::exists(path) ? readAll(path) : std::string()) == expected_map);
+  CHECK(readAll(previous) == expected_previous);
+
+  // The next start: the killed save's temporary goes, the newest complete map loads.
+  CHECK(MapStore::removeOrphanedTemporaries(path) == (kill_at <= 2 ? 1 : 0));
+  RecoveredMap recovered = MapStore::recover(path, sim);
+  REQUIRE(recovered.map);
+  CHECK(recovered.problems.empty());
+  CHECK(recovered.map->application_data == (kill_at == 1 ? "current" : kill_at == 2 ? "current" : "next"));
+  CHECK(recovered.loaded_from == (kill_at == 2 ? previous : path));
+  // And the next save after it restores both names, as two files.
+  MapStore::writeAtomically(path, next);
+  CHECK(MapStore::fileVerifies(path));
+  CHECK(inodeOf(path) != inodeOf(previous));
+  CHECK(namesIn(dir) == std::vector<std::string>{"map.tsm", "map.tsm.prev"});
+}
+
+namespace {
+
+/// Fails a save's `fail_at`-th rename (1-based) with EIO.
+class FailRename : public MapFileOps {
+ public:
+  explicit FailRename(int fail_at) : fail_at_(fail_at) {}
+  int rename(const char* from, const char* to) const override {
+    if (++renames_ == fail_at_) {
+      errno = EIO;
+      return -1;
+    }
+    return MapFileOps::rename(from, to);
+  }
+
+ private:
+  int fail_at_;
+  mutable int renames_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("GIVEN a map WHEN the rename that puts the new map in place fails THEN the map is back under its name",
+          "[topology][map][reliability]") {
+  auto sim = placeSimilarity();
+  const TempFolder temp("fail-rename");
+  const fs::path path = temp.path / "map.tsm";
+  const std::string current = MapStore::encode(*smallFilter(sim, 8), "current");
+  MapStore::writeAtomically(path, current);
+  const int fail_at = GENERATE(1, 2);
+  try {
+    MapStore::writeAtomically(path, MapStore::encode(*smallFilter(sim, 12), "next"), FailRename(fail_at));
+    FAIL("the save did not fail");
+  } catch (const MapStoreError& e) {
+    INFO(e.what());
+    CHECK_THAT(e.what(), Catch::Contains(path.string()) && Catch::Contains(std::strerror(EIO)) &&
+                             Catch::Contains("the previous map file is unchanged"));
+  }
+  CHECK(readAll(path) == current);
+  CHECK(namesIn(temp.path) == std::vector<std::string>{"map.tsm"});
+}
+
+TEST_CASE("GIVEN map paths that cannot be saved WHEN checked at start THEN the problem is named, and a good path "
+          "leaves nothing behind",
+          "[topology][map][reliability]") {
+  const TempFolder temp("writable");
+  const fs::path& dir = temp.path;
+  auto refusal = [](const fs::path& path) -> std::string {
+    try {
+      MapStore::checkWritable(path);
+    } catch (const MapStoreError& e) {
+      return e.what();
+    }
+    return {};
+  };
+  SECTION("a good folder: the probe file is made and removed") {
+    CHECK(refusal(dir / "map.tsm").empty());
+    CHECK(filesIn(dir) == 0);
+  }
+  SECTION("a directory at the map path") {
+    fs::create_directory(dir / "map.tsm");
+    CHECK_THAT(refusal(dir / "map.tsm"), Catch::Contains((dir / "map.tsm").string() + " is a directory"));
+  }
+  SECTION("a directory at the .prev path") {
+    fs::create_directory(dir / "map.tsm.prev");
+    CHECK_THAT(refusal(dir / "map.tsm"), Catch::Contains((dir / "map.tsm.prev").string() + " is a directory"));
+  }
+  SECTION("a folder that does not exist") {
+    CHECK_THAT(refusal(dir / "missing" / "map.tsm"), Catch::Contains("folder " + (dir / "missing").string() +
+                                                                     " does not exist"));
+  }
+  SECTION("a folder where no file can be created") {
+    // Root ignores permission bits; sysfs takes no new file, even from root.
+    fs::path folder = "/sys";
+    if (geteuid() != 0) {
+      folder = dir / "read-only";
+      fs::create_directory(folder);
+      fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
+    }
+    CHECK_THAT(refusal(folder / "map.tsm"), Catch::Contains("cannot create a file in " + folder.string()));
+    std::error_code ignored;  // so that the folder can be removed (root: there is none)
+    fs::permissions(dir / "read-only", fs::perms::owner_all, fs::perm_options::replace, ignored);
+  }
+  SECTION("a full disk") {
+    try {
+      MapStore::checkWritable(dir / "map.tsm", FullDisk(0));
+      FAIL("not refused");
+    } catch (const MapStoreError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("cannot write a file in") && Catch::Contains(std::strerror(ENOSPC)));
+    }
+    CHECK(filesIn(dir) == 0);
+  }
 }

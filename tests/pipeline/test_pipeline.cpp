@@ -676,3 +676,39 @@ SCENARIO("The status line names the camera state") {
   s.source_reconnects = 1;
   CHECK_THAT(statusLine(s), Catch::EndsWith("camera reconnecting (attempt 1, 1 reconnects, 0 lost by the driver)"));
 }
+
+SCENARIO("GIVEN a disk that refuses the final map save WHEN the pipeline stops THEN the save is tried again, and "
+         "one that never works is an error that names it") {
+  ManualClock clock;
+  FakeSource source(30);
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  const int failing = GENERATE(2, 3);  // writes that fail before one works (3: every attempt)
+  std::atomic<int> attempts{0};
+  topology.on_write = [&] {
+    if (attempts.fetch_add(1) < failing) throw std::runtime_error("cannot write map: File too large");
+  };
+  Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation, topology,
+                    sink, clock);
+  pipeline.start();
+  pipeline.wait();
+  CHECK(attempts.load() == 3);
+  REQUIRE_FALSE(sink.statuses.empty());
+  if (failing == 2) {
+    CHECK(pipeline.error().empty());
+    CHECK(topology.saves.size() == 1);
+    CHECK(sink.statuses.back().maps_saved == 1);
+    CHECK(sink.statuses.back().map_save_failures == 0);  // reset by the save that worked
+  } else {
+    CHECK_THAT(pipeline.error(), Catch::Contains("saving the map to /tmp/unused-by-fake.tsm failed 3 times: cannot "
+                                                 "write map: File too large"));
+    CHECK(topology.saves.empty());
+    CHECK(sink.statuses.back().maps_saved == 0);
+    CHECK(sink.statuses.back().map_save_failures == 3);
+    CHECK_THAT(statusLine(sink.statuses.back()),
+               Catch::EndsWith("; map save failing (3 in a row, retrying; the previous map is kept): cannot write "
+                               "map: File too large"));
+  }
+}

@@ -161,9 +161,10 @@ TEST_CASE(
   CHECK(MapStore::previousPath(map) == std::filesystem::path("state/map.tsm.prev"));
   CHECK(MapStore::recoveryCandidates(map) ==
         std::vector<std::filesystem::path>{"state/map.tsm", "state/map.tsm.prev"});
-  CHECK(MapStore::previousTemporaryPath("state/.map.tsm.Ab3dE9") == "state/.map.tsm.Ab3dE9.prev");
+  CHECK(MapStore::probePath("state/.map.tsm.Ab3dE9") == "state/.map.tsm.Ab3dE9.probe");
   CHECK(MapStore::isTemporaryOf(map, ".map.tsm.Ab3dE9"));
   CHECK(MapStore::isTemporaryOf(map, ".map.tsm.Zz0000.prev"));
+  CHECK(MapStore::isTemporaryOf(map, ".map.tsm.Zz0000.probe"));
   for (const char* other : {"map.tsm", "map.tsm.prev", ".map.tsm.lock", ".map.tsm.toolong7",
                             ".other.tsm.Ab3dE9", ".map.tsm.Ab3d-9", ".map.tsm.Ab3dE9.next"})
     CHECK_FALSE(MapStore::isTemporaryOf(map, other));

@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -48,6 +49,10 @@ struct ConfigKey {
   /// A constraint involving other keys: "" or the problem without the key's path (e.g. "0.3 is out of
   /// range, allowed [0, gamma = 0.2]"). Checked after every key's own range.
   std::function<std::string(const DaemonConfig&)> cross_check;
+  /// True when the key changes what the mapping decides (which frames count, how they are fingerprinted,
+  /// compared, segmented, how the filter weighs them): a map records its value, and a run with another
+  /// value is refused the map unless map.resume_other_settings (mapDecisionSettings, docs/daemon.md).
+  bool recorded_in_map = false;
   /// Reads / writes the key's member of DaemonConfig.
   std::function<ConfigValue(const DaemonConfig&)> get;
   std::function<void(DaemonConfig&, const ConfigValue&)> set;
@@ -80,5 +85,9 @@ const std::vector<ConfigKey>& daemonConfigKeys();
 const std::vector<ConfigSection>& daemonConfigSections();
 /// The key at `path`; throws std::out_of_range naming the path if there is none.
 const ConfigKey& daemonConfigKey(std::string_view path);
+
+/// "path" -> value (as YAML text) of every key recorded_in_map, read from `config`: what a map records it
+/// was made with.
+std::map<std::string, std::string> mapDecisionSettings(const DaemonConfig& config);
 
 }  // namespace toposlam

@@ -6,6 +6,7 @@
 //
 // save()/writeAtomically() replace a map atomically and keep the file replaced as <path>.prev when it
 // verifies; any failure (e.g. a full disk) throws MapStoreError and leaves the old file untouched.
+// checkWritable() proves at start that a save can succeed (the programs call it before any frame).
 // load() never modifies the file on disk; a file larger than the size cap is refused from its size
 // before anything is read, and a file is read once, into one buffer. recover() is the daemon's start:
 // the newest file that loads, damaged ones moved aside. MapLock keeps a second writer off a map.
@@ -74,7 +75,15 @@ LoadedMap load(const std::filesystem::path& path, const SimilarityMeasure& simil
 RecoveredMap recover(const std::filesystem::path& path, const SimilarityMeasure& similarity,
                      std::uint64_t max_bytes = kDefaultMaxMapBytes);
 
-/// Removes the temporary files of interrupted saves of `path` (".<name>.XXXXXX[.prev]" beside it).
+/// Throws MapStoreError naming the problem unless a map can be saved at `path`: neither it nor its .prev is
+/// a directory (or another non-file), its folder exists, and a probe file beside it can be created, written,
+/// fsync'ed, renamed and removed (the steps of a save). Leaves nothing behind (a probe a kill interrupted
+/// is a temporary that removeOrphanedTemporaries recognises). Permissions, a read-only file system, a
+/// full disk or a missing folder show here; a file-size limit (ulimit -f) does not (the first save over
+/// it fails with EFBIG).
+void checkWritable(const std::filesystem::path& path, const MapFileOps& ops = MapFileOps{});
+
+/// Removes the temporary files of interrupted saves of `path` (".<name>.XXXXXX[.prev|.probe]" beside it).
 /// Returns how many were removed. Call it while holding the map's MapLock.
 int removeOrphanedTemporaries(const std::filesystem::path& path);
 

@@ -13,7 +13,9 @@
 // a place is spread over the following frames: per frame the topology thread spends at most
 // `filter_budget_ms` in TopologyStage::advance(). A status is published every `status_period_s`. The map
 // is saved atomically every `MapConfig::save_period_s` and at stop: the topology thread takes an in-memory
-// snapshot, the map writer thread writes it (fsync off the frame path).
+// snapshot, the map writer thread writes it (fsync off the frame path). A write that fails is retried
+// with a growing wait (a newer snapshot takes its place), counted in the status (map_save_failures) while
+// the run goes on; the final save is tried three times before it is the pipeline's error.
 //
 // The capture thread reads the source with a bounded wait (FrameSource::nextFor), so it keeps beating
 // while a camera is silent or reconnecting: that is healthy, and the status says "reconnecting". A stage
@@ -89,7 +91,7 @@ struct PipelineConfig {
 };
 
 /// map.*: the map file. The Pipeline saves it (path, save_period_s); toposlamd decides at start what it
-/// loads (load_at_start, resume_other_source, source_from_start, max_mb).
+/// loads (load_at_start, resume_other_source, resume_other_settings, source_from_start, max_mb).
 struct MapConfig {
   std::string path;  ///< map.path: where the map is saved; empty = never saved
   /// map.save_period_s: periodic save, seconds (0 = only at stop; else 1 .. 86400)
@@ -97,6 +99,8 @@ struct MapConfig {
   bool load_at_start = true;  ///< map.load_at_start: resume from `path` if it exists
   /// map.resume_other_source: resume a map recorded from another source (else refused, exit 2)
   bool resume_other_source = false;
+  /// map.resume_other_settings: resume a map made with other decision settings (else refused, exit 2)
+  bool resume_other_settings = false;
   /// map.source_from_start: a resumed map's images: source starts from its first frame, not after the
   /// last frame the map holds
   bool source_from_start = false;
@@ -182,6 +186,9 @@ class Pipeline {
   /// The counters a status reads (publisher thread); `published`: the publisher's own count.
   StatusCounters statusCounters(std::int64_t published) const;
   void mapWriterLoop();
+  /// Writes one snapshot (map writer thread): true when it is on disk; a failure is counted, logged and
+  /// kept for the status (the final save is tried kFinalSaveAttempts times before it is an error).
+  bool writeMap(const MapWrite& job);
   /// Snapshot now (topology thread, when idle) and hand it to the map writer; `final` at stop.
   void saveMap(bool final);
   void beat(StageIndex stage);
@@ -220,6 +227,8 @@ class Pipeline {
   std::atomic<std::int64_t> processed_[kThreadCount] = {};
   std::atomic<double> thread_cpu_s_[kThreadCount] = {};  ///< CPU time of each stage thread so far
   std::atomic<std::int64_t> maps_saved_{0};
+  std::atomic<std::int64_t> map_save_failures_{0};  ///< failed map writes since the last one that succeeded
+  std::string map_save_problem_;                    ///< the last failure's message (status_mutex_)
   std::atomic<int> places_{0};
   std::atomic<std::int64_t> place_queue_kept_waits_{0};  ///< the place queue was full (topology thread)
   std::atomic<std::size_t> place_queue_high_water_{0};

@@ -268,6 +268,8 @@ struct PipelineStatus {
   int places = 0;                    ///< places closed so far
   std::int64_t map_revision = 0;
   std::int64_t maps_saved = 0;
+  std::int64_t map_save_failures = 0;  ///< failed map writes since the last one that succeeded (retried)
+  std::string map_save_problem;        ///< the last failure, while map_save_failures > 0
   std::string state;                 ///< "running", "stopping", "finished"
 };
 

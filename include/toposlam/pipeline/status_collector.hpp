@@ -38,6 +38,8 @@ struct StatusCounters {
   std::int64_t place_queue_kept_waits = 0;  ///< the topology stage's place queue was full
   std::int64_t map_revision = 0;
   std::int64_t maps_saved = 0;
+  std::int64_t map_save_failures = 0;
+  std::string map_save_problem;
 };
 
 class StatusCollector {

@@ -11,7 +11,10 @@
 // where bytes(x) = u64 size + x. The application data is opaque to MapStore (the `map` command keeps
 // its place/frame bookkeeping there). The settings are "key=value" lines that decide whether a map can
 // be continued by a run (the keypoint backend: ORB descriptors mean nothing to a SIFT run; the source,
-// kMapSourceKey: a simulated office is no part of the robot's real map); checkSettings() compares them.
+// kMapSourceKey: a simulated office is no part of the robot's real map; from version 4, every config key
+// that changes what the mapping decides, by its path: "segmentation.window=25"); checkSettings() compares
+// them. Version 4 differs from 3 only in what the settings hold: a reader of 3 reads it, and a map of
+// version 2 or 3 still loads (its settings name the keypoints and the source only).
 //
 // This header is the format and the policies, with no I/O (an algorithm touches no file): encode()
 // and decode() turn a filter into a file image and back; MapFramingCheck verifies a file's framing piece
@@ -21,9 +24,10 @@
 //
 // The policies:
 // - Writing is atomic (a temporary file ".<name>.XXXXXX" in the same directory, fsync'ed, renamed over
-//   the target, the directory fsync'ed). The file it replaces is kept as "<path>.prev" (a hard link, made
-//   through ".<name>.XXXXXX.prev"), but only when that file verifies (framing and checksum), so saving
-//   over a damaged map never pushes the last good one out of .prev.
+//   the target, the directory fsync'ed). The file it replaces is first renamed to "<path>.prev", but only
+//   when that file verifies (framing and checksum), so saving over a damaged map never pushes the last
+//   good one out of .prev. At every instant <path> or <path>.prev is a complete map, and the two are
+//   never one file; between the two renames <path> is missing and recovery loads <path>.prev.
 // - Recovery tries the map, then its .prev (recoveryCandidates); a file that does not load is moved
 //   aside under a timestamped name (<path>.damaged-YYYYmmddTHHMMSS[-N]; never over an earlier one) and
 //   the oldest damaged copies beyond kMaxDamagedFiles are removed.
@@ -50,7 +54,7 @@
 
 namespace toposlam {
 
-inline constexpr std::uint32_t kMapFormatVersion = 3;
+inline constexpr std::uint32_t kMapFormatVersion = 4;
 /// Default cap on a map file's size (bytes): a bigger file is refused before it is read. A map of 100
 /// places with 500 particles is about 1 MB.
 inline constexpr std::uint64_t kDefaultMaxMapBytes = 256ull << 20;
@@ -145,13 +149,14 @@ std::string checkSettings(const MapSettings& recorded, const MapSettings& curren
 inline constexpr const char* kTemporaryInfix = ".";
 /// "<path>.prev": the map a save replaced, when it verified.
 std::filesystem::path previousPath(const std::filesystem::path& path);
-/// The name the replaced map is linked to before it is renamed to previousPath(): the save's own
-/// temporary file's name + ".prev" (so that a kill -9 leaves only names isTemporaryOf recognises).
-std::string previousTemporaryPath(const std::string& temporary_path);
+/// The name a start-up probe (checkWritable) renames its temporary file to: the temporary's name +
+/// ".probe" (so that a kill -9 leaves only names isTemporaryOf recognises).
+std::string probePath(const std::string& temporary_path);
 /// The files recovery tries, newest first: the map, then its .prev.
 std::vector<std::filesystem::path> recoveryCandidates(const std::filesystem::path& path);
 /// True when `file_name` (a bare name in the map's directory) is the temporary file of a save of `path`
-/// (".<name>.XXXXXX" or ".<name>.XXXXXX.prev", six letters or digits).
+/// (".<name>.XXXXXX", ".<name>.XXXXXX.probe", or ".<name>.XXXXXX.prev", the link older builds made;
+/// six letters or digits).
 bool isTemporaryOf(const std::filesystem::path& path, const std::string& file_name);
 /// Where a damaged `file` is moved: "<file>.damaged-<timestamp>", or "...-<attempt>" for attempt >= 1
 /// (when the earlier names are taken).

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -28,6 +29,7 @@
 #include "commands.hpp"
 #include "config_key_options.hpp"
 #include "offline_run_io.hpp"
+#include "toposlam/config/config_keys.hpp"
 #include "toposlam/config/daemon_config.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
@@ -63,6 +65,7 @@ struct MapOptions {
   int max_representatives = keyDefaultInt("topology.max_representatives_per_node");
   std::string resume;
   bool resume_other_source = false;  ///< --resume-other-source: continue a map made from another source
+  bool resume_other_settings = false;  ///< --resume-other-settings: continue a map made with other settings
   std::string keypoints = "orb";
   SegmentationOptions segmentation;
   MotionOptions motion;
@@ -149,6 +152,25 @@ MapLock lockRunFolderMap(const fs::path& map_path, const std::string& out) {
   return lock;
 }
 
+/// What a map made by this run records: the keys toposlamd records (the key table's recorded_in_map, read
+/// from the settings this run uses), the keypoint backend and the first source; so that toposlamd (and
+/// --resume) can tell a map made with other settings (`--preset thesis` against the default).
+MapSettings mapSettingsOf(const VpackConfig& vpack, const NgramSimilarityConfig& similarity,
+                          const FiedlerSegmenterConfig& segmenter, const TopologyFilterConfig& filter,
+                          const SequenceEvidenceConfig& evidence, const std::string& source_uri) {
+  DaemonConfig config;
+  config.fingerprint = vpack;
+  config.similarity = similarity;
+  config.segmentation = segmenter;
+  config.segmentation_stage.motion = MotionGateConfig{};  // the offline run's motion gate
+  config.topology = filter;
+  config.sequence_evidence = evidence;
+  MapSettings settings = fingerprintMapSettings(vpack);
+  for (auto& [key, value] : mapDecisionSettings(config)) settings[key] = std::move(value);
+  settings[kMapSourceKey] = sourceIdentity(source_uri);
+  return settings;
+}
+
 /// The preset's VPACK settings with --keypoints and --max-keypoints.
 VpackConfig fingerprintConfig(const MapOptions& o, const MethodPreset& preset) {
   VpackConfig vpack = preset.fingerprint;
@@ -181,9 +203,11 @@ struct StartingFilter {
 };
 
 /// --resume: the saved map, refused (ConfigError naming the option that would accept it) when it was made
-/// with other keypoints or from another source.
-StartingFilter resumedFilter(const MapOptions& o, const VpackConfig& vpack, const NgramSimilarity& similarity,
-                             const Clock& clock, bool filter_options_given) {
+/// with other keypoints, from another source, or with other settings (`settings_for(uri)`: what this run
+/// records for a source).
+StartingFilter resumedFilter(const MapOptions& o, const NgramSimilarity& similarity, const Clock& clock,
+                             bool filter_options_given,
+                             const std::function<MapSettings(const std::string&)>& settings_for) {
   if (filter_options_given) {
     throw std::invalid_argument(
         "map: --particles, --alpha, --seed and --max-representatives come from the map "
@@ -191,19 +215,32 @@ StartingFilter resumedFilter(const MapOptions& o, const VpackConfig& vpack, cons
   }
   LoadedMap loaded = MapStore::load(o.resume, similarity);
   // ORB descriptors mean nothing to a SIFT run (and so on), and another source (a simulated office, a
-  // camera elsewhere) is no continuation unless the user says so: the map says what it was made with.
+  // camera elsewhere) or other settings are no continuation unless the user says so: the map says what
+  // it was made with.
+  const std::map<std::string, std::string> decision_keys = mapDecisionSettings(DaemonConfig());
+  bool unrecorded = false;
   for (const std::string& uri : o.sources) {
-    MapSettings current = fingerprintMapSettings(vpack);
-    current[kMapSourceKey] = sourceIdentity(uri);
+    MapSettings current = settings_for(uri);
     std::string hint;
     if (settingDiffers(loaded.settings, current, "keypoints")) hint += "--keypoints";
     if (o.resume_other_source)
       current.erase(kMapSourceKey);
     else if (settingDiffers(loaded.settings, current, kMapSourceKey))
       hint += std::string(hint.empty() ? "" : "; ") + "--resume-other-source continues it from this source";
+    bool other_settings = false;
+    for (const auto& [key, value] : decision_keys) {
+      other_settings = other_settings || settingDiffers(loaded.settings, current, key);
+      unrecorded = unrecorded || loaded.settings.count(key) == 0;
+      if (o.resume_other_settings) current.erase(key);
+    }
+    if (other_settings && !o.resume_other_settings)
+      hint += std::string(hint.empty() ? "" : "; ") + "--resume-other-settings continues it with this run's settings";
     const std::string refusal = MapStore::checkSettings(loaded.settings, current, o.resume);
     if (!refusal.empty()) throw ConfigError("map: " + refusal + " (" + hint + ")");
   }
+  if (unrecorded)
+    std::cerr << "map: warning: " << o.resume << " records the keypoints and the source only (it was made by an older "
+              << "toposlam): its other settings cannot be compared; continuing it with this run's\n";
   TopologyFilterConfig config = loaded.filter->config();
   config.candidates = o.candidates;  // how this run compares, not saved with the map (adoptMap applies it)
   StartingFilter start;
@@ -216,9 +253,8 @@ StartingFilter resumedFilter(const MapOptions& o, const VpackConfig& vpack, cons
   return start;
 }
 
-/// A new filter: the preset's, with the filter options given.
-StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const NgramSimilarity& similarity,
-                         const Clock& clock) {
+/// The filter config of a new map: the preset's, with the filter options given.
+TopologyFilterConfig newFilterConfig(const MapOptions& o, const MethodPreset& preset) {
   TopologyFilterConfig config = preset.topology;
   config.particles = o.particles;
   config.alpha = o.alpha;
@@ -234,9 +270,15 @@ StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const 
   config.candidates = o.candidates;
   if (const std::string problem = config.validate(); !problem.empty())
     throw std::invalid_argument("map: " + problem);
+  return config;
+}
+
+/// A new filter: the preset's, with the filter options given.
+StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const NgramSimilarity& similarity,
+                         const Clock& clock) {
   StartingFilter start;
-  start.topology =
-      std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, TopologyStageConfig{});
+  start.topology = std::make_unique<ParticleFilterTopologyStage>(newFilterConfig(o, preset), similarity, clock,
+                                                                 TopologyStageConfig{});
   return start;
 }
 
@@ -570,6 +612,11 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   const fs::path out_dir(o.out);
   createRunFolder(o.out);
   const fs::path map_path = out_dir / "map.tsm";
+  try {
+    MapStore::checkWritable(map_path);  // found out now, not after the run
+  } catch (const MapStoreError& e) {
+    throw ConfigError(std::string("map: ") + e.what());
+  }
   const MapLock map_lock = lockRunFolderMap(map_path, o.out);
 
   const MethodPreset preset = presetOf(o.segmentation, "map");
@@ -580,13 +627,17 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   // The filter steps run to their end before the next frame, so the budget's clock is never read for a
   // decision (ParticleFilterTopologyStage::advance with an infinite budget).
   const ManualClock clock;
+  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, framesBySequence(o, preset));
+  const NgramSimilarityConfig similarity_config = similarityConfig(o, preset);
+  const auto settings_for = [&](const std::string& uri) {
+    return mapSettingsOf(vpack, similarity_config, segmenter_config, newFilterConfig(o, preset), evidence, uri);
+  };
   StartingFilter start = o.resume.empty() ? newFilter(o, preset, similarity, clock)
-                                          : resumedFilter(o, vpack, similarity, clock, filter_options_given);
+                                          : resumedFilter(o, similarity, clock, filter_options_given, settings_for);
   ParticleFilterTopologyStage& topology = *start.topology;
   const TopologyParticleFilter& filter = topology.filter();
   const int first_observation = filter.observationCount();
 
-  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, framesBySequence(o, preset));
   // Thumbnails are the daemon's (place events); the offline run keeps none.
   FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
   OfflineRunner runner(fingerprint_stage, segmentation_stage, &topology);
@@ -600,8 +651,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
                              " refused)");
   // The map first: it is the run's work and what --resume continues. A report file that cannot be
   // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
-  MapSettings made_with = fingerprintMapSettings(vpack);
-  made_with[kMapSourceKey] = sourceIdentity(o.sources.front());  // the first traversal's source
+  const MapSettings made_with = mapSettingsOf(vpack, similarity_config, segmenter_config, filter.config(), evidence,
+                                              o.sources.front());  // the first traversal's source
   MapStore::save(map_path, filter, encodeOrigins(start.origins), made_with);
 
   // The most probable topology decides every place's node.
@@ -750,6 +801,10 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--resume", options->resume, "Continue the map in this map.tsm");
   cmd->add_flag("--resume-other-source", options->resume_other_source,
                 "With --resume: continue a map made from another source (refused otherwise)")
+      ->needs("--resume");
+  cmd->add_flag("--resume-other-settings", options->resume_other_settings,
+                "With --resume: continue a map made with other settings (preset, segmentation, similarity, ...; "
+                "refused otherwise). The keypoints must agree; the filter's settings come from the map")
       ->needs("--resume");
   cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
       ->capture_default_str();

@@ -3,12 +3,15 @@
 // a program of their own, toposlam-bench (bench/); `toposlam bench` only says so (command_bench.cpp).
 //
 // Exit status (src/apps/common/cli_main.hpp): 0 ok, 1 runtime error, 2 usage or config error.
+#include <csignal>
+
 #include <spdlog/spdlog.h>
 
 #include "cli_main.hpp"
 #include "commands.hpp"
 #include "toposlam/platform/logging.hpp"
 #include "toposlam/platform/opencv_runtime.hpp"
+#include "toposlam/platform/signal_mask.hpp"
 
 namespace {
 
@@ -39,5 +42,8 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   toposlam::keepOpenCvOffOpenCl();
+  // A file written beyond the file-size limit (ulimit -f) is a failed write (EFBIG) that the command reports,
+  // keeping the file it would have replaced, not death by SIGXFSZ halfway.
+  toposlam::ignoreSignals({SIGXFSZ});
   return run(argc, argv);
 }

@@ -1,11 +1,18 @@
 // toposlamd's body; see daemon.hpp. Signals are blocked in every thread (the mask is set before any thread
 // exists, threads inherit it) and taken synchronously by the main thread (waitForSignal, platform/os), so no work
 // happens in a signal handler:
-//   SIGTERM, SIGINT, SIGHUP, SIGQUIT   finish the filter step in progress, save the map, exit 0
+//   SIGTERM, SIGINT, SIGHUP, SIGQUIT and every other signal that would end the process and can be taken
+//   (SIGXCPU, SIGPWR, SIGVTALRM, SIGPROF, SIGIO, SIGSYS, SIGSTKFLT, SIGRTMIN..SIGRTMAX; platform/os,
+//   catchableTerminatingSignals)
+//                                      finish the filter step in progress, save the map, exit 0
 //   SIGUSR1, SIGUSR2, SIGALRM          logged and otherwise ignored (their default would kill the daemon
 //                                      without a final save)
-//   SIGPIPE                            ignored: a write to a closed pipe (a log reader gone) fails with
-//                                      EPIPE, which the writers treat as a failed write, not as the end
+//   SIGPIPE, SIGXFSZ                   ignored: a write to a closed pipe (a log reader gone) fails with
+//                                      EPIPE, one beyond the file-size limit (ulimit -f) with EFBIG, which
+//                                      the writers treat as a failed write (a map save is retried, the
+//                                      previous map kept), not as the end
+//   SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGABRT, SIGKILL, SIGSTOP: their default (nothing trusted to
+//                                      save, or nothing to catch)
 #include "daemon.hpp"
 
 #include <algorithm>
@@ -25,6 +32,7 @@
 
 #include "lcm_channels.hpp"
 #include "sources.hpp"
+#include "toposlam/config/config_keys.hpp"
 #include "toposlam/core/worker_pool.hpp"
 #include "toposlam/io/recording_frame_source.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
@@ -32,6 +40,7 @@
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
+#include "toposlam/platform/file_system.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
 #include "toposlam/platform/signal_mask.hpp"
 #include "toposlam/platform/systemd_notifier.hpp"
@@ -42,18 +51,32 @@ namespace toposlam::daemon {
 
 namespace {
 
-constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT};
+/// Taken by the main thread, logged and otherwise ignored; every other signal it takes stops the daemon.
 constexpr int kIgnoredSignals[] = {SIGUSR1, SIGUSR2, SIGALRM};
+/// Ignored by the process: the write that raised one fails instead (EPIPE, EFBIG).
+const std::vector<int> kWriteSignals = {SIGPIPE, SIGXFSZ};
 
 bool isStopSignal(int signal) {
-  return std::find(std::begin(kStopSignals), std::end(kStopSignals), signal) != std::end(kStopSignals);
+  return signal != 0 &&
+         std::find(std::begin(kIgnoredSignals), std::end(kIgnoredSignals), signal) == std::end(kIgnoredSignals);
 }
 
-/// Every signal the main thread takes with waitForSignal (stop and ignored ones).
-std::vector<int> handledSignalNumbers() {
-  std::vector<int> signals(std::begin(kStopSignals), std::end(kStopSignals));
-  signals.insert(signals.end(), std::begin(kIgnoredSignals), std::end(kIgnoredSignals));
-  return signals;
+/// Every signal the main thread takes with waitForSignal (stop and ignored ones): every signal that would end
+/// the process and can be caught.
+std::vector<int> handledSignalNumbers() { return catchableTerminatingSignals(); }
+
+/// Proves at start that the map can be saved, before any frame (MapStore::checkWritable, exit 2 otherwise),
+/// and says when a file-size limit may stop a later save.
+void checkMapSavable(const std::string& path) {
+  if (path.empty()) return;
+  MapStore::checkWritable(path);
+  if (const std::uint64_t limit = fileSizeLimitBytes(); limit > 0) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    spdlog::warn("toposlamd: files are limited to {} bytes here (ulimit -f){}: a map save beyond it fails (EFBIG), "
+                 "is retried and reported, and the previous map is kept", limit,
+                 ec ? std::string() : "; the map " + path + " is " + std::to_string(size) + " bytes");
+  }
 }
 
 /// The fingerprint stage's pool threads (tsl-vpack-1, ...) take the fingerprint thread's scheduling from
@@ -217,6 +240,59 @@ void continueSource(const MapSettings& recorded, const DaemonConfig& config, Fra
                  config.source, *next - 1, name->second, *next);
 }
 
+/// What a map made by this run records: mapDecisionSettings (the key table's recorded_in_map keys), the
+/// keypoint backend under its older name ("keypoints", what maps before format 4 recorded) and the source.
+MapSettings mapSettingsOf(const DaemonConfig& config) {
+  MapSettings settings = fingerprintMapSettings(config.fingerprint);
+  for (auto& [key, value] : mapDecisionSettings(config)) settings[key] = std::move(value);
+  settings[kMapSourceKey] = mapSourceOf(config.source);
+  return settings;
+}
+
+/// Throws MapStoreError (exit 2) naming the settings that differ unless a map recorded with `recorded` may be
+/// continued by this run: the keypoint backend always agrees, the source unless map.resume_other_source,
+/// every other recorded setting unless map.resume_other_settings (then each is named in a warning). A map
+/// that records none of the settings (made before format 4) cannot be compared: said, and continued.
+/// Returns true when the map was made from another source.
+bool checkResumable(const MapSettings& recorded, const MapSettings& current, const MapConfig& map,
+                    const std::string& name) {
+  const MapSettings decision_keys = mapDecisionSettings(DaemonConfig());
+  const bool other_source = settingDiffers(recorded, current, kMapSourceKey);
+  std::vector<std::string> other_settings, unrecorded;
+  for (const auto& [key, value] : decision_keys) {
+    if (recorded.count(key) == 0)
+      unrecorded.push_back(key);
+    else if (settingDiffers(recorded, current, key))
+      other_settings.push_back(key + "=" + recorded.at(key) + " (now " + current.at(key) + ")");
+  }
+  MapSettings compared = current;
+  if (map.resume_other_source) compared.erase(kMapSourceKey);
+  if (map.resume_other_settings)
+    for (const auto& [key, value] : decision_keys) compared.erase(key);
+  if (const std::string refusal = MapStore::checkSettings(recorded, compared, name); !refusal.empty()) {
+    std::string hint;
+    if (other_source && !map.resume_other_source)
+      hint += "map.resume_other_source: true or --resume-other-source continues it from this source; ";
+    if (!other_settings.empty() && !map.resume_other_settings)
+      hint += "map.resume_other_settings: true or --resume-other-settings continues it with this run's settings; ";
+    throw MapStoreError(refusal + " (" + hint + "--no-map-load starts a new map)");
+  }
+  if (other_source)
+    spdlog::warn("toposlamd: the map {} was made from {}; continuing it from {} (map.resume_other_source)", name,
+                 recorded.at(kMapSourceKey), current.at(kMapSourceKey));
+  if (!other_settings.empty()) {
+    std::string list;
+    for (const std::string& setting : other_settings) list += (list.empty() ? "" : ", ") + setting;
+    spdlog::warn("toposlamd: the map {} was made with other settings; continuing it with this run's "
+                 "(map.resume_other_settings), the filter's own from the map: {}", name, list);
+  }
+  if (!unrecorded.empty())
+    spdlog::warn("toposlamd: the map {} records {} of the {} settings a map made now records (it was made by an "
+                 "older toposlam): they cannot be compared; continuing it with this run's settings", name,
+                 unrecorded.size() == decision_keys.size() ? "none" : "not all", decision_keys.size());
+  return other_source;
+}
+
 }  // namespace
 
 std::string resolveMapPath(const std::string& path) {
@@ -233,13 +309,15 @@ std::string resolveMapPath(const std::string& path) {
 
 int runDaemon(const DaemonConfig& config) {
   const std::vector<int> signals = handledSignalNumbers();
-  blockSignals(signals);  // before any thread exists: all inherit it
-  std::signal(SIGPIPE, SIG_IGN);                  // EPIPE instead of death on a closed log pipe
+  blockSignals(signals);        // before any thread exists: all inherit it
+  ignoreSignals(kWriteSignals);  // EPIPE instead of death on a closed log pipe, EFBIG beyond ulimit -f
 
   SystemdNotifier notifier;
   SteadyClock clock;
   MapConfig map_config = config.map;
   map_config.path = resolveMapPath(config.map.path);
+  // A map that cannot be saved is found out now, not after a session of mapping.
+  checkMapSavable(map_config.path);
 
   Assembly parts(config, clock, config.source);
   RecordingFrameSource* recording = startRecording(config.record, parts.source);
@@ -254,9 +332,9 @@ int runDaemon(const DaemonConfig& config) {
       spdlog::info("toposlamd: removed {} temporary file(s) of interrupted map saves beside {}", orphans,
                    map_config.path);
   }
-  // What the map records (and saves) as made with: the fingerprint settings and this run's source.
-  MapSettings map_settings = fingerprintMapSettings(config.fingerprint);
-  map_settings[kMapSourceKey] = mapSourceOf(config.source);
+  // What the map records (and saves) as made with: every setting that changes what the mapping decides,
+  // the keypoint backend and this run's source.
+  MapSettings map_settings = mapSettingsOf(config);
   parts.topology->setMapSettings(map_settings);
   FrameSource& named_source = *parts.source;
   parts.topology->nameFramesWith([&named_source](std::int64_t sequence) { return named_source.frameName(sequence); });
@@ -267,28 +345,19 @@ int runDaemon(const DaemonConfig& config) {
     RecoveredMap recovered = MapStore::recover(map_config.path, *parts.similarity, max_bytes);
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
-      // Another source continues the map only when told to (map.resume_other_source); other fingerprint
-      // settings never do. From then on the map records this source.
-      const MapSettings& recorded = recovered.map->settings;
-      const bool other_source = settingDiffers(recorded, map_settings, kMapSourceKey);
-      MapSettings compared = map_settings;
-      if (config.map.resume_other_source) compared.erase(kMapSourceKey);
-      const std::string refusal =
-          MapStore::checkSettings(recorded, compared, recovered.loaded_from.string());
-      if (!refusal.empty())
-        throw MapStoreError(refusal + (other_source && !config.map.resume_other_source
-                                           ? " (map.resume_other_source: true or --resume-other-source continues "
-                                             "it from this source; --no-map-load starts a new map)"
-                                           : ""));
-      if (other_source)
-        spdlog::warn("toposlamd: the map {} was made from {}; continuing it from {} (map.resume_other_source)",
-                     recovered.loaded_from.string(), recorded.at(kMapSourceKey), map_settings.at(kMapSourceKey));
-      const MapSettings recorded_settings = recorded;
+      const MapSettings recorded = recovered.map->settings;
+      const bool other_source = checkResumable(recorded, map_settings, config.map, recovered.loaded_from.string());
       parts.topology->adoptMap(std::move(*recovered.map));
+      // From then on the map records this run's settings, with the filter's own from the map (they came
+      // with it), and this source.
+      DaemonConfig effective = config;
+      effective.topology = parts.topology->filter().config();
+      map_settings = mapSettingsOf(effective);
+      parts.topology->setMapSettings(map_settings);
       spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
                    parts.topology->observations(),
                    recovered.problems.empty() ? "" : ", the newest file that loads");
-      if (!other_source) continueSource(recorded_settings, config, *parts.source, *parts.topology);
+      if (!other_source) continueSource(recorded, config, *parts.source, *parts.topology);
     } else if (!recovered.problems.empty()) {
       spdlog::error("toposlamd: no map file of {} loads; starting a new map", map_config.path);
     }
@@ -349,6 +418,8 @@ int runDaemon(const DaemonConfig& config) {
     const int signal = waitForSignal(signals, stopping ? std::min(tick_s, 0.1) : tick_s);
     if (signal != 0 && !isStopSignal(signal)) {
       spdlog::info("toposlamd: {} received: ignored (stop with SIGTERM, SIGINT, SIGHUP or SIGQUIT)", strsignal(signal));
+    } else if (signal != 0 && stopping) {
+      spdlog::info("toposlamd: {} received while stopping: the map is being saved", strsignal(signal));
     } else if (signal != 0 && !stopping) {
       stopping = true;
       spdlog::info("toposlamd: {} received: finishing the filter step in progress and saving the map",

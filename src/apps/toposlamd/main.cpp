@@ -21,6 +21,7 @@
 #include "toposlam/pipeline/frame_source.hpp"
 #include "toposlam/platform/logging.hpp"
 #include "toposlam/platform/opencv_runtime.hpp"
+#include "toposlam/platform/signal_mask.hpp"
 #include "toposlam/topology/map_store.hpp"
 
 namespace {
@@ -39,8 +40,9 @@ int startError(const std::exception& e, int code) {
 // RestartPreventExitStatus=2).
 int main(int argc, char** argv) {
   toposlam::keepOpenCvOffOpenCl();  // before any OpenCV call
-  // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE.
-  std::signal(SIGPIPE, SIG_IGN);
+  // Before the first log line: a closed log pipe must be a write error (EPIPE), not death by SIGPIPE; a
+  // write beyond ulimit -f one too (EFBIG), not death by SIGXFSZ.
+  toposlam::ignoreSignals({SIGPIPE, SIGXFSZ});
   CLI::App app{"toposlamd: real-time visual topological SLAM service, publishing places over LCM"};
   app.set_version_flag("--version", "toposlamd " TOPOSLAM_VERSION);  // project(VERSION), the package version
   std::string config_path;

@@ -50,7 +50,7 @@ SCENARIO(
     CHECK(write.write("first", FileWriteOps{}) == 0);
     CHECK(write.sync(FileWriteOps{}) == 0);
     CHECK(write.close() == 0);
-    CHECK(write.replaceTarget() == 0);
+    CHECK(write.replaceTarget(FileWriteOps{}) == 0);
     CHECK(write.syncFolder(FileWriteOps{}) == 0);
   }
   CHECK(readAll(target) == "first");

@@ -4,8 +4,8 @@
 // never half of one; a failure at any step leaves the target as it was. Linux/POSIX (mkstemp, fsync,
 // rename, open(O_DIRECTORY)).
 //
-// The steps are separate calls so that a caller can act between them (MapStore keeps the file being
-// replaced as "<path>.prev" after the flush and before the rename) and word each failure itself; each
+// The steps are separate calls so that a caller can act between them (MapStore renames the file being
+// replaced to "<path>.prev" after the flush and before the rename) and word each failure itself; each
 // step returns 0 or the error number the system gave (for std::strerror). Until replaceTarget()
 // succeeds, the destructor closes and removes the temporary file.
 // Not thread-safe: one writer per object.
@@ -26,6 +26,9 @@ class FileWriteOps {
   virtual long write(int fd, const void* data, std::size_t size) const;
   /// Like ::fsync: 0, or -1 with errno set.
   virtual int fsync(int fd) const;
+  /// Like ::rename: 0, or -1 with errno set. Every rename of a save goes through here, so that a test can
+  /// stop the process between two of them as a kill would.
+  virtual int rename(const char* from, const char* to) const;
 };
 
 class AtomicFileWrite {
@@ -46,7 +49,7 @@ class AtomicFileWrite {
   /// Closes the temporary file (a deferred write error shows here).
   int close();
   /// Renames the temporary file over the target; from then on the temporary file is the target.
-  int replaceTarget();
+  int replaceTarget(const FileWriteOps& ops);
   /// Closes and removes the temporary file now (after a failed step; replaceTarget() not done yet).
   /// Idempotent; the destructor does it too.
   void discard();

@@ -48,4 +48,8 @@ int renameFile(const std::filesystem::path& from, const std::filesystem::path& t
 /// Removes the name `path` (not a folder).
 int removeFile(const std::filesystem::path& path);
 
+/// The largest file this process may write (RLIMIT_FSIZE, the shell's ulimit -f), bytes; 0 when unlimited.
+/// A write beyond it fails with EFBIG once SIGXFSZ is ignored (signal_mask.hpp, ignoreSignals).
+std::uint64_t fileSizeLimitBytes();
+
 }  // namespace toposlam

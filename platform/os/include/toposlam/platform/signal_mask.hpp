@@ -11,6 +11,21 @@
 
 namespace toposlam {
 
+/// Every signal whose default action ends the process, that another process can send, and that a thread
+/// waiting for it (waitForSignal) can take safely: SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGUSR1, SIGUSR2,
+/// SIGALRM, SIGXCPU, SIGVTALRM, SIGPROF, SIGIO, SIGPWR, SIGSYS, SIGSTKFLT and SIGRTMIN..SIGRTMAX (those the C
+/// library does not keep for itself). Not in it: SIGKILL and SIGSTOP (they cannot be caught); SIGSEGV,
+/// SIGBUS, SIGFPE, SIGILL, SIGTRAP and SIGABRT (a fault of the thread that raised it, or a request for a
+/// core dump: nothing in the process is trusted to be saved); SIGPIPE and SIGXFSZ (raised in the thread
+/// whose write failed: ignore them with ignoreSignals, and the write fails with EPIPE or EFBIG instead).
+/// SIGSYS sent by another process is taken like SIGTERM; one the kernel raises for a forbidden system call
+/// (seccomp) is delivered despite the mask and ends the process as before.
+std::vector<int> catchableTerminatingSignals();
+
+/// Sets `signals` to be ignored by the whole process (SIG_IGN): SIGPIPE, SIGXFSZ. Returns 0 or the error
+/// number.
+int ignoreSignals(const std::vector<int>& signals);
+
 /// Adds `signals` (SIGINT, SIGTERM, ...) to the calling thread's blocked set: they stay pending until
 /// unblocked or taken with sigwait/sigtimedwait.
 int blockSignals(const std::vector<int>& signals);
