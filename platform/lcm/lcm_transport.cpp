@@ -24,6 +24,7 @@
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
 #include "toposlam_lcm/place_v1_t.hpp"
+#include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
@@ -332,6 +333,8 @@ const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length
 const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
 const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
                             text(), fixed(8 + 8), length(), array(kStageStatus)};
+const WireSchema kStatusV1 = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
+                              text(), fixed(8), length(), array(kStageStatus)};  // before motion_refused
 const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
 const WireSchema kTopology = {fixed(8 + 8 + 8 + 4 + 4), length(), array(kTopologyNode), length(), array(12)};
 const WireSchema kMotion = {fixed(8 * 7 + 1)};
@@ -374,11 +377,52 @@ bool decodePlaceMessage(const void* data, std::size_t size, toposlam_lcm::place_
   return true;
 }
 
+namespace {
+
+/// A TOPOSLAM_STATUS message as status_t or, failing that, as status_v1_t (recorded before motion_refused
+/// existed; it then reads 0).
+bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::status_t& out) {
+  if (decodeMessage(data, size, out, "status")) return true;
+  toposlam_lcm::status_v1_t old{};
+  if (!decodeMessage(data, size, old, "status_v1")) return false;
+  out = toposlam_lcm::status_t{};
+  out.utime = old.utime;
+  out.state = old.state;
+  out.uptime_s = old.uptime_s;
+  out.fps = old.fps;
+  out.frames_captured = old.frames_captured;
+  out.frames_published = old.frames_published;
+  out.frames_dropped = old.frames_dropped;
+  out.queue_kept_waits = old.queue_kept_waits;
+  out.source_skipped = old.source_skipped;
+  out.source_state = old.source_state;
+  out.source_reconnects = old.source_reconnects;
+  out.source_reconnect_attempts = old.source_reconnect_attempts;
+  out.source_dropped = old.source_dropped;
+  out.latency_median_ms = old.latency_median_ms;
+  out.latency_p99_ms = old.latency_p99_ms;
+  out.latency_max_ms = old.latency_max_ms;
+  out.cpu_percent = old.cpu_percent;
+  out.places = old.places;
+  out.map_revision = old.map_revision;
+  out.maps_saved = old.maps_saved;
+  out.motion_messages = old.motion_messages;
+  out.motion_state = old.motion_state;
+  out.motion_standing_frames = old.motion_standing_frames;
+  out.motion_refused = 0;
+  out.num_stages = old.num_stages;
+  out.stages = old.stages;
+  return true;
+}
+
+}  // namespace
+
 bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t size) {
   const WireSchema* schema = kind == "place"         ? &kPlace
                              : kind == "place_v1"    ? &kPlaceV1
                              : kind == "place_event" ? &kPlaceEvent
                              : kind == "status"      ? &kStatus
+                             : kind == "status_v1"   ? &kStatusV1
                              : kind == "topology"    ? &kTopology
                              : kind == "motion"      ? &kMotion
                                                      : nullptr;
@@ -525,7 +569,7 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
     }
   } else if (kind == "status") {
     toposlam_lcm::status_t m{};
-    ok = decodeMessage(data, size, m, kind);
+    ok = decodeStatusMessage(data, size, m);  // recordings from before motion_refused: status_v1_t
     if (ok) {
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);

@@ -20,6 +20,7 @@
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
 #include "toposlam_lcm/place_v1_t.hpp"
+#include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
@@ -294,6 +295,31 @@ TEST_CASE("GIVEN a place message recorded before match_* existed (place_v1_t) WH
   CHECK_THAT(out.json, Catch::Contains("\"match_frame\":-1"));
   // Cut short, neither type reads it.
   CHECK_FALSE(decodeLcmMessage("place", "TOPOSLAM_PLACE", bytes.data(), bytes.size() - 1, out));
+}
+
+TEST_CASE("GIVEN a status message recorded before motion_refused existed (status_v1_t) WHEN decoded THEN it reads "
+          "with none refused",
+          "[platform][lcm]") {
+  toposlam_lcm::status_v1_t old{};
+  old.state = "running";
+  old.frames_captured = 1234;
+  old.source_state = "streaming";
+  old.motion_state = "used";
+  old.motion_standing_frames = 17;
+  old.num_stages = 1;
+  old.stages.resize(1);
+  old.stages[0].name = "capture";
+  old.stages[0].processed = 99;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(old.getEncodedSize()));
+  REQUIRE(old.encode(bytes.data(), 0, static_cast<int>(bytes.size())) == static_cast<int>(bytes.size()));
+  ReceivedMessage out;
+  REQUIRE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size(), out));
+  CHECK_THAT(out.json, Catch::Contains("\"frames_captured\":1234"));
+  CHECK_THAT(out.json, Catch::Contains("\"motion_standing_frames\":17"));
+  CHECK_THAT(out.json, Catch::Contains("\"motion_refused\":0"));
+  CHECK_THAT(out.json, Catch::Contains("\"processed\":99"));
+  // Cut short, neither type reads it.
+  CHECK_FALSE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size() - 1, out));
 }
 
 TEST_CASE("GIVEN a motion_t with every field set WHEN encoded and decoded THEN every field comes back, and "
