@@ -224,6 +224,7 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.motion_state = toString(motion_ ? static_cast<MotionUse>(motion_->use.load()) : MotionUse::None);
   msg.motion_standing_frames = motion_ ? motion_->standing_frames.load() : 0;
   msg.motion_refused = motion_ ? motion_->refused.load() : 0;
+  msg.motion_malformed = motion_ ? motion_->malformed.load() : 0;
   msg.num_stages = static_cast<std::int32_t>(s.stages.size());
   msg.stages.reserve(s.stages.size());
   for (const StageStatus& st : s.stages) {
@@ -332,7 +333,7 @@ const WireSchema kPlaceV1 = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), f
 const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length(), array(1), fixed(8)};
 const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
 const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
-                            text(), fixed(8 + 8), length(), array(kStageStatus)};
+                            text(), fixed(8 + 8 + 8), length(), array(kStageStatus)};
 const WireSchema kStatusV1 = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
                               text(), fixed(8), length(), array(kStageStatus)};  // before motion_refused
 const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
@@ -410,6 +411,7 @@ bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::statu
   out.motion_state = old.motion_state;
   out.motion_standing_frames = old.motion_standing_frames;
   out.motion_refused = 0;
+  out.motion_malformed = 0;
   out.num_stages = old.num_stages;
   out.stages = old.stages;
   return true;
@@ -584,7 +586,8 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
       jsonNumber(w, "cpu_percent", m.cpu_percent);
       w.field("places", m.places).field("map_revision", m.map_revision).field("maps_saved", m.maps_saved)
           .field("motion_messages", m.motion_messages).field("motion_state", m.motion_state)
-          .field("motion_standing_frames", m.motion_standing_frames).field("motion_refused", m.motion_refused);
+          .field("motion_standing_frames", m.motion_standing_frames).field("motion_refused", m.motion_refused)
+          .field("motion_malformed", m.motion_malformed);
       w.key("stages").beginArray();
       for (const auto& st : m.stages) {
         w.beginObject().field("name", st.name);
@@ -606,7 +609,8 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
                     m.source_state.c_str(), static_cast<long long>(m.source_reconnects),
                     static_cast<long long>(m.source_dropped));
       out.summary = line;
-      if (const std::string motion = motionStatusText(m.motion_state, m.motion_standing_frames, m.motion_refused);
+      if (const std::string motion = motionStatusText(m.motion_state, m.motion_standing_frames, m.motion_refused,
+                                                          m.motion_malformed);
           !motion.empty())
         out.summary += "  " + motion;
     }

@@ -203,6 +203,8 @@ MotionStatusHistory motionStatusHistory(const std::vector<ReceivedMessage>& stat
     h.standing_frames = std::max(h.standing_frames, integerField(statuses[i], "motion_standing_frames"));
     if (json.find("\"motion_refused\"") != std::string::npos)
       h.refused = std::max(h.refused, integerField(statuses[i], "motion_refused"));
+    if (json.find("\"motion_malformed\"") != std::string::npos)
+      h.malformed = std::max(h.malformed, integerField(statuses[i], "motion_malformed"));
   }
   if (!statuses.empty()) h.messages = integerField(statuses.back(), "motion_messages");
   return h;

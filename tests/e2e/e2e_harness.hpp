@@ -114,6 +114,7 @@ struct MotionStatusHistory {
   std::int64_t standing_frames = 0;  ///< largest motion_standing_frames
   std::int64_t messages = -1;        ///< motion_messages of the last status, -1 without a status
   std::int64_t refused = 0;          ///< largest motion_refused
+  std::int64_t malformed = 0;        ///< largest motion_malformed
 };
 MotionStatusHistory motionStatusHistory(const std::vector<ReceivedMessage>& statuses);
 

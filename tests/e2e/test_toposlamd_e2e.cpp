@@ -417,7 +417,8 @@ SCENARIO("Robot motion over LCM: the status says it is used while it arrives, an
   }
 }
 
-SCENARIO("One motion message stamped with the wall clock among the robot's: refused and counted, the stop still seen") {
+SCENARIO("One motion message stamped with the wall clock among the robot's: refused and counted, the stop still seen; "
+         "two messages that are not motion_t counted as malformed") {
   GIVEN("toposlamd on the simulated office at 25 fps and a robot node standing for 4 s, with one message in Unix time") {
     const fs::path dir = freshDirectory("motion-wall-clock");
     Heard heard;
@@ -447,6 +448,10 @@ SCENARIO("One motion message stamped with the wall clock among the robot's: refu
                            std::chrono::system_clock::now().time_since_epoch())
                            .count();
           robot->publish(LcmChannels{}.motion, &wall);
+          // ... and two messages that are not motion_t at all (a node publishing another type on the channel).
+          const std::string garbage = "not a motion_t";
+          for (int i = 0; i < 2; ++i)
+            robot->publish(LcmChannels{}.motion, garbage.data(), static_cast<unsigned int>(garbage.size()));
         }
       }
       const bool lost = !heard.statuses.empty() &&
@@ -463,6 +468,7 @@ SCENARIO("One motion message stamped with the wall clock among the robot's: refu
       const e2e::MotionStatusHistory status = e2e::motionStatusHistory(heard.statuses);
       INFO("last status " << heard.statuses.back().json);
       CHECK(status.refused == 1);
+      CHECK(status.malformed == 2);
       CHECK(status.first_used >= 0);
       CHECK(status.first_lost > status.first_used);
       // As in the scenario without the stray message: standing from 1 s after the first sample to 1 s after

@@ -221,15 +221,18 @@ inline const char* toString(MotionUse use) {
   return use == MotionUse::Used ? "used" : use == MotionUse::Lost ? "lost" : use == MotionUse::Stale ? "stale" : "none";
 }
 
-/// The motion part of a status line, from the status message's motion_state, standing frames and refused
-/// samples: "motion used, 12 standing frames skipped", "motion stale (segmenting by time), 0 standing frames
-/// skipped, motion refused 3"; "" while no motion arrived and none was refused.
-inline std::string motionStatusText(const std::string& state, std::int64_t standing_frames, std::int64_t refused) {
-  if (state == toString(MotionUse::None) && refused == 0) return "";
+/// The motion part of a status line, from the status message's motion_state, standing frames, refused samples
+/// and malformed messages: "motion used, 12 standing frames skipped", "motion stale (segmenting by time), 0
+/// standing frames skipped, motion refused 3, motion malformed 2"; "" while no motion arrived and nothing was
+/// refused or dropped.
+inline std::string motionStatusText(const std::string& state, std::int64_t standing_frames, std::int64_t refused,
+                                    std::int64_t malformed) {
+  if (state == toString(MotionUse::None) && refused == 0 && malformed == 0) return "";
   std::string text = "motion " + state;
   if (state == toString(MotionUse::Lost) || state == toString(MotionUse::Stale)) text += " (segmenting by time)";
   text += ", " + std::to_string(standing_frames) + " standing frames skipped";
   if (refused > 0) text += ", motion refused " + std::to_string(refused);
+  if (malformed > 0) text += ", motion malformed " + std::to_string(malformed);
   return text;
 }
 
@@ -240,11 +243,12 @@ struct MotionStatusCounters {
   std::atomic<int> use{static_cast<int>(MotionUse::None)};  ///< a MotionUse, at the last frame
   std::atomic<std::int64_t> standing_frames{0};  ///< frames left out of segmentation as standing
   std::atomic<std::int64_t> refused{0};          ///< samples the motion gate refused (MotionRefusals::total)
+  std::atomic<std::int64_t> malformed{0};        ///< motion messages that could not be decoded (dropped)
 };
 /// motionStatusText of the counters as they are now.
 inline std::string motionStatusText(const MotionStatusCounters& counters) {
   return motionStatusText(toString(static_cast<MotionUse>(counters.use.load())), counters.standing_frames.load(),
-                          counters.refused.load());
+                          counters.refused.load(), counters.malformed.load());
 }
 
 struct PipelineStatus {

@@ -399,8 +399,11 @@ int runDaemon(const DaemonConfig& config) {
     }
   } end_io_threads{receiving, recording};
   io_threads.start(config.pipeline.threads.lcm_receiver, [&] {
-    while (receiving.load())
-      if (!motion.handle(200)) break;
+    while (receiving.load()) {
+      const bool open = motion.handle(200);
+      motion_status.malformed.store(motion.malformed());  // dropped by the subscriber, counted in the status
+      if (!open) break;
+    }
   });
   // The recording's writer: nice 10 by default, so encoding and writing frames yield to the stage threads.
   if (recording != nullptr)

@@ -133,6 +133,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
   motion.use.store(static_cast<int>(MotionUse::Used));
   motion.standing_frames.store(11);
   motion.refused.store(3);
+  motion.malformed.store(4);
   const std::int64_t before_us = monotonicMicroseconds();
   {
     LcmPipelineSink sink("file://" + path + "?mode=w", channels, 95, &motion);
@@ -237,6 +238,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(m.motion_state == "used");
     CHECK(m.motion_standing_frames == 11);
     CHECK(m.motion_refused == 3);
+    CHECK(m.motion_malformed == 4);
     REQUIRE(m.num_stages == 2);
     CHECK(m.stages[0].name == "capture");
     CHECK(m.stages[0].latency_median_ms == 0.5f);
@@ -272,7 +274,9 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(received[3].kind == "status");
     CHECK_THAT(received[3].json, Catch::Contains("\"frames_captured\":3000000001"));
     CHECK_THAT(received[3].json, Catch::Contains("\"motion_refused\":3"));
-    CHECK_THAT(received[3].summary, Catch::EndsWith("  motion used, 11 standing frames skipped, motion refused 3"));
+    CHECK_THAT(received[3].json, Catch::Contains("\"motion_malformed\":4"));
+    CHECK_THAT(received[3].summary,
+               Catch::EndsWith("  motion used, 11 standing frames skipped, motion refused 3, motion malformed 4"));
   }
 }
 
@@ -317,6 +321,7 @@ TEST_CASE("GIVEN a status message recorded before motion_refused existed (status
   CHECK_THAT(out.json, Catch::Contains("\"frames_captured\":1234"));
   CHECK_THAT(out.json, Catch::Contains("\"motion_standing_frames\":17"));
   CHECK_THAT(out.json, Catch::Contains("\"motion_refused\":0"));
+  CHECK_THAT(out.json, Catch::Contains("\"motion_malformed\":0"));
   CHECK_THAT(out.json, Catch::Contains("\"processed\":99"));
   // Cut short, neither type reads it.
   CHECK_FALSE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size() - 1, out));
