@@ -32,7 +32,8 @@ found=""
 for _ in 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20; do
   sleep 0.25
   found=$(for t in /proc/$pid/task/*; do echo "$(cat "$t/comm" 2>/dev/null) $(cut -d' ' -f19 "$t/stat" 2>/dev/null)"; done | sort)
-  case "$found" in *tsl-rec-custom*) break ;; esac
+  # The I/O threads start before the pipeline's: wait for both (a loaded machine starts them apart).
+  case "$found" in *tsl-fingerprint*tsl-rec-custom*) break ;; esac
 done
 kill -TERM $pid 2>/dev/null || true
 wait $pid || true

@@ -283,8 +283,9 @@ TEST_CASE("GIVEN checksummed frames with absurd values WHEN estimated THEN the p
     m.time_us += 20000;
     CHECK_FALSE(e.onWheel(m, 1040000));
     m.time_us += 20000;
+    // 0.1 mm on: the right counter wraps past INT32_MAX, as a cumulative counter on the wire does.
     m.left_um += 100;
-    m.right_um += 100;
+    m.right_um = static_cast<std::int32_t>(static_cast<std::uint32_t>(m.right_um) + 100u);
     const auto s = e.onWheel(m, 1060000);
     REQUIRE(s);
     CHECK(s->forward_m == Approx(0.0001));
