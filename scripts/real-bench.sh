@@ -9,7 +9,9 @@
 #
 # Columns: frame-level recall at 100 % precision of the published answer (its matches ranked by score), the
 # published matches as they are (right, wrong, and frames with a true match left without one), the ORB
-# baseline's recall at 100 % precision (single frames), and whole-run ms per frame (map, wall clock).
+# baseline's recall at 100 % precision (single frames), the topology's place revisits (places put on the node
+# of an earlier place they truly revisit / on a wrong earlier node / on a new node, judged by the set's
+# loop-closure truth: eval.json's place_revisits), and whole-run ms per frame (map, wall clock).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:-$root/build}"
@@ -38,7 +40,9 @@ run_set() {  # name source truth
   python3 - "$name" "$work/$name.eval.json" "$work/$name.orb.json" "$work/$name/frames.csv" "$t0" "$t1" <<'PY'
 import csv, json, sys
 name, eval_path, orb_path, frames_path, t0, t1 = sys.argv[1:7]
-e = json.load(open(eval_path))["frame_loop_closure"]
+run = json.load(open(eval_path))
+e = run["frame_loop_closure"]
+v = run.get("place_revisits", {"closed_right": 0, "wrong_closures": 0, "missed": 0, "merged_with_previous": 0, "revisits": 0})
 orb_r = float("nan")
 try:
     for m in json.load(open(orb_path))["methods"]:
@@ -49,12 +53,13 @@ except (OSError, ValueError, KeyError):
 frames = sum(1 for _ in csv.DictReader(open(frames_path)))
 ms = (float(t1) - float(t0)) * 1e3 / max(frames, 1)
 with_match, detections, right = e["frames_with_match"], e["detections"], e["right_detections"]
-print("| %s | %d | %.3f | %d / %d / %d | %.3f | %.1f |" % (
-    name, frames, e["recall_at_100_precision"], right, detections - right, with_match - right, orb_r, ms))
+print("| %s | %d | %.3f | %d / %d / %d | %.3f | %d / %d / %d of %d | %.1f |" % (
+    name, frames, e["recall_at_100_precision"], right, detections - right, with_match - right, orb_r,
+    v["closed_right"], v["wrong_closures"], v["missed"] + v["merged_with_previous"], v["revisits"], ms))
 PY
 }
 
-echo "| real set, one stream | frames | published match: recall at 100 % precision | published matches right / wrong / missed | ORB baseline: recall at 100 % precision | map ms per frame |"
-echo "|---|---|---|---|---|---|"
+echo "| real set, one stream | frames | published match: recall at 100 % precision | published matches right / wrong / missed | ORB baseline: recall at 100 % precision | topology: revisits closed / wrong / missed | map ms per frame |"
+echo "|---|---|---|---|---|---|---|"
 run_set samples "images:$data/rtabmap-samples/samples" "$data/rtabmap-samples/samples_GT.bmp"
 run_set corridor "images:$stream/frames" "$stream/gt_pairs.csv"

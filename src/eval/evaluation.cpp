@@ -226,6 +226,9 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
                            std::to_string(n) + " frames");
       }
       lct = truthFromMatrix(m, result.min_gap);
+      std::vector<PlaceSpan> spans;
+      for (const auto& p : run.places) spans.push_back(PlaceSpan{p.first, p.last, static_cast<int>(p.node)});
+      result.place_revisits = scorePlaceRevisits(spans, m);
     }
     result.loop_closure = precisionRecall(lct, pairsFromAssignments(node_of_frame, probability));
     // Frame level (the literature's scoring), when frames.csv carries the detections of `map`.
@@ -252,7 +255,7 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
 
   if (truth.kind != Truth::Kind::Labels) {
     result.notes.push_back("ground truth is a loop-closure " + result.truth_kind +
-                           ": localisation, segmentation and topology measures need labels.csv");
+                           ": localisation, segmentation and room-level topology measures need labels.csv");
   } else {
     // Localisation: a node stands for the room most of its frames are in.
     if (has_nodes) {
@@ -297,6 +300,11 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
         std::vector<PlaceSpan> spans;
         for (const auto& p : run.places) spans.push_back(PlaceSpan{p.first, p.last, static_cast<int>(p.node)});
         result.place_revisits = scorePlaceRevisits(spans, poses);
+        if (run.has_frame_matches) {
+          std::vector<std::int64_t> match;
+          for (const auto& f : run.frames) match.push_back(f.match);
+          result.frame_matches_by_pose = scoreFrameMatchesByPose(match, poses);
+        }
       }
     }
   }
@@ -429,9 +437,16 @@ void writeEvalJson(std::ostream& out, const EvalResult& r) {
         .field("missed", v.missed)
         .field("merged_with_previous", v.merged_with_previous)
         .field("wrong_closures", v.wrong_closures)
-        .field("radius_m", v.radius_m)
-        .field("max_heading_rad", v.max_heading_rad)
-        .field("min_overlap", v.min_overlap);
+        .field("judged_by", v.by_pose ? "pose" : "loop-closure truth");
+    if (v.by_pose) json.field("radius_m", v.radius_m).field("max_heading_rad", v.max_heading_rad);
+    json.field("min_overlap", v.min_overlap);
+    json.endObject();
+  }
+  if (r.frame_matches_by_pose) {
+    const FrameMatchPoseScore& v = *r.frame_matches_by_pose;
+    json.key("frame_matches_by_pose").beginObject();
+    json.field("matches", v.matches).field("right", v.right).field("wrong", v.wrong);
+    json.field("radius_m", v.radius_m).field("max_heading_rad", v.max_heading_rad);
     json.endObject();
   }
   json.key("best_topology_probability").beginArray();
@@ -556,9 +571,13 @@ std::vector<Table> tables(const EvalResult& r) {
   }
   if (r.place_revisits) {
     const PlaceRevisitScore& v = *r.place_revisits;
-    Table t{"Place revisits by pose (a place revisits the earlier places that saw at least " +
-                fmt("%.0f%%", 100.0 * v.min_overlap) + " of its frames from within " + fmt("%.1f m", v.radius_m) +
-                " and " + fmt("%.0f deg", v.max_heading_rad * 180.0 / 3.14159265358979323846) + ")",
+    const std::string within =
+        v.by_pose ? " of its frames from within " + fmt("%.1f m", v.radius_m) + " and " +
+                        fmt("%.0f deg", v.max_heading_rad * 180.0 / 3.14159265358979323846) + ")"
+                  : " of its frames, by the loop-closure ground truth)";
+    Table t{std::string(v.by_pose ? "Place revisits by pose" : "Place revisits") +
+                " (a place revisits the earlier places that saw at least " + fmt("%.0f%%", 100.0 * v.min_overlap) +
+                within,
             {"measure", "value"},
             {}};
     t.rows.push_back({"places", std::to_string(v.places)});
@@ -568,6 +587,18 @@ std::vector<Table> tables(const EvalResult& r) {
     t.rows.push_back({"missed (a new node)", std::to_string(v.missed)});
     t.rows.push_back({"left on the previous place's node", std::to_string(v.merged_with_previous)});
     t.rows.push_back({"wrong closures", std::to_string(v.wrong_closures)});
+    out.push_back(t);
+  }
+  if (r.frame_matches_by_pose) {
+    const FrameMatchPoseScore& v = *r.frame_matches_by_pose;
+    Table t{"Frame matches by pose (a published match is right when its frame was taken within " +
+                fmt("%.1f m", v.radius_m) + " and " + fmt("%.0f deg", v.max_heading_rad * 180.0 / 3.14159265358979323846) +
+                " of the frame's pose)",
+            {"measure", "value"},
+            {}};
+    t.rows.push_back({"published matches", std::to_string(v.matches)});
+    t.rows.push_back({"right", std::to_string(v.right)});
+    t.rows.push_back({"wrong", std::to_string(v.wrong)});
     out.push_back(t);
   }
   if (!r.best_topology_probability.empty()) {

@@ -332,44 +332,35 @@ TopologyScore scoreTopology(const std::vector<int>& place_node, const std::vecto
   return score;
 }
 
-PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<GroundPose>& poses,
-                                     double radius_m, double max_heading_rad, double min_overlap) {
-  if (!(radius_m > 0) || !(max_heading_rad > 0) || !(min_overlap > 0 && min_overlap <= 1))
-    throw std::invalid_argument("scorePlaceRevisits: radius and heading must be > 0, overlap in (0, 1]");
-  const auto n = static_cast<std::int64_t>(poses.size());
+namespace {
+
+/// The counts of PlaceRevisitScore, with "frame f shows what frame g shows" and "f's truth is known" given.
+template <typename Known, typename Same>
+PlaceRevisitScore countPlaceRevisits(const std::vector<PlaceSpan>& places, std::int64_t frames, double min_overlap,
+                                     const Known& known, const Same& same) {
+  if (!(min_overlap > 0 && min_overlap <= 1))
+    throw std::invalid_argument("scorePlaceRevisits: the overlap must be in (0, 1]");
   for (const PlaceSpan& p : places) {
-    if (p.first < 0 || p.last < p.first || p.last >= n)
+    if (p.first < 0 || p.last < p.first || p.last >= frames)
       throw std::invalid_argument("scorePlaceRevisits: place frames " + std::to_string(p.first) + ".." +
-                                  std::to_string(p.last) + " outside the " + std::to_string(n) + " poses");
+                                  std::to_string(p.last) + " outside the " + std::to_string(frames) + " frames");
   }
-  const auto known = [&](std::int64_t f) {
-    const GroundPose& q = poses[static_cast<std::size_t>(f)];
-    return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.heading);
-  };
-  const auto close = [&](std::int64_t f, std::int64_t g) {
-    const GroundPose& a = poses[static_cast<std::size_t>(f)];
-    const GroundPose& b = poses[static_cast<std::size_t>(g)];
-    const double turn = std::abs(std::remainder(a.heading - b.heading, 2.0 * 3.14159265358979323846));
-    return std::hypot(a.x - b.x, a.y - b.y) <= radius_m && turn <= max_heading_rad;
-  };
   // Share of place k's known frames that place j covers.
   const auto overlap = [&](const PlaceSpan& k, const PlaceSpan& j) {
-    int frames = 0, covered = 0;
+    int counted = 0, covered = 0;
     for (std::int64_t f = k.first; f <= k.last; ++f) {
       if (!known(f)) continue;
-      ++frames;
+      ++counted;
       for (std::int64_t g = j.first; g <= j.last; ++g) {
-        if (known(g) && close(f, g)) {
+        if (known(g) && same(f, g)) {
           ++covered;
           break;
         }
       }
     }
-    return frames == 0 ? 0.0 : static_cast<double>(covered) / frames;
+    return counted == 0 ? 0.0 : static_cast<double>(covered) / counted;
   };
   PlaceRevisitScore score;
-  score.radius_m = radius_m;
-  score.max_heading_rad = max_heading_rad;
   score.min_overlap = min_overlap;
   std::set<int> seen_nodes;
   for (std::size_t k = 0; k < places.size(); ++k) {
@@ -401,6 +392,64 @@ PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const
     }
     seen_nodes.insert(node);
   }
+  return score;
+}
+
+}  // namespace
+
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<GroundPose>& poses,
+                                     double radius_m, double max_heading_rad, double min_overlap) {
+  if (!(radius_m > 0) || !(max_heading_rad > 0) || !(min_overlap > 0 && min_overlap <= 1))
+    throw std::invalid_argument("scorePlaceRevisits: radius and heading must be > 0, overlap in (0, 1]");
+  const auto known = [&](std::int64_t f) {
+    const GroundPose& q = poses[static_cast<std::size_t>(f)];
+    return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.heading);
+  };
+  const auto close = [&](std::int64_t f, std::int64_t g) {
+    const GroundPose& a = poses[static_cast<std::size_t>(f)];
+    const GroundPose& b = poses[static_cast<std::size_t>(g)];
+    const double turn = std::abs(std::remainder(a.heading - b.heading, 2.0 * 3.14159265358979323846));
+    return std::hypot(a.x - b.x, a.y - b.y) <= radius_m && turn <= max_heading_rad;
+  };
+  PlaceRevisitScore score =
+      countPlaceRevisits(places, static_cast<std::int64_t>(poses.size()), min_overlap, known, close);
+  score.radius_m = radius_m;
+  score.max_heading_rad = max_heading_rad;
+  return score;
+}
+
+FrameMatchPoseScore scoreFrameMatchesByPose(const std::vector<std::int64_t>& match, const std::vector<GroundPose>& poses,
+                                            double radius_m, double max_heading_rad) {
+  if (!(radius_m > 0) || !(max_heading_rad > 0))
+    throw std::invalid_argument("scoreFrameMatchesByPose: radius and heading must be > 0");
+  if (match.size() != poses.size())
+    throw std::invalid_argument("scoreFrameMatchesByPose: " + std::to_string(match.size()) + " frames but " +
+                                std::to_string(poses.size()) + " poses");
+  const auto known = [](const GroundPose& q) { return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.heading); };
+  FrameMatchPoseScore score;
+  score.radius_m = radius_m;
+  score.max_heading_rad = max_heading_rad;
+  for (std::size_t f = 0; f < match.size(); ++f) {
+    const std::int64_t g = match[f];
+    if (g < 0 || g >= static_cast<std::int64_t>(poses.size())) continue;
+    const GroundPose& a = poses[f];
+    const GroundPose& b = poses[static_cast<std::size_t>(g)];
+    if (!known(a) || !known(b)) continue;
+    ++score.matches;
+    const double turn = std::abs(std::remainder(a.heading - b.heading, 2.0 * 3.14159265358979323846));
+    if (std::hypot(a.x - b.x, a.y - b.y) <= radius_m && turn <= max_heading_rad) ++score.right;
+    else ++score.wrong;
+  }
+  return score;
+}
+
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const LoopClosureMatrix& same,
+                                     double min_overlap) {
+  // A frame with no true match anywhere still counts: a place of frames nobody saw again covers nothing.
+  const auto known = [](std::int64_t) { return true; };
+  const auto shows = [&](std::int64_t f, std::int64_t g) { return same.at(static_cast<int>(f), static_cast<int>(g)); };
+  PlaceRevisitScore score = countPlaceRevisits(places, same.size, min_overlap, known, shows);
+  score.by_pose = false;
   return score;
 }
 

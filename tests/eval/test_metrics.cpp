@@ -278,3 +278,53 @@ SCENARIO("GIVEN two laps cut into places WHEN revisits are scored by pose THEN r
   CHECK_THROWS_AS(scorePlaceRevisits({PlaceSpan{0, 900, 0}}, poses), std::invalid_argument);
   CHECK_THROWS_AS(scorePlaceRevisits({}, poses, 0.0), std::invalid_argument);
 }
+
+SCENARIO("GIVEN a real set's loop-closure truth WHEN revisits are scored by it THEN places are judged by its frame pairs") {
+  // 60 frames: two laps of 30 (frame 30 + i shows what frame i shows, and its neighbours within 1).
+  LoopClosureMatrix m;
+  m.size = 60;
+  m.same.assign(60 * 60, 0);
+  for (int i = 0; i < 30; ++i)
+    for (int d = -1; d <= 1; ++d)
+      if (i + d >= 0 && i + d < 30) {
+        m.same[static_cast<std::size_t>((30 + i) * 60 + i + d)] = 1;
+        m.same[static_cast<std::size_t>((i + d) * 60 + 30 + i)] = 1;
+      }
+  const auto places = [](std::vector<int> nodes) {  // six places of 10 frames
+    std::vector<PlaceSpan> spans;
+    for (int p = 0; p < 6; ++p) spans.push_back(PlaceSpan{10 * p, 10 * p + 9, nodes[static_cast<std::size_t>(p)]});
+    return spans;
+  };
+  const PlaceRevisitScore right = scorePlaceRevisits(places({0, 1, 2, 0, 1, 2}), m);
+  CHECK(right.by_pose == false);
+  CHECK(right.revisits == 3);
+  CHECK(right.closed_right == 3);
+  const PlaceRevisitScore new_nodes = scorePlaceRevisits(places({0, 1, 2, 3, 4, 5}), m);
+  CHECK(new_nodes.missed == 3);
+  CHECK(new_nodes.closed_right == 0);
+  const PlaceRevisitScore swapped = scorePlaceRevisits(places({0, 1, 2, 1, 0, 2}), m);
+  CHECK(swapped.closed_right == 1);
+  CHECK(swapped.wrong_closures == 2);
+  // A first lap alone has nothing to revisit, and a node reused there is a wrong closure.
+  CHECK(scorePlaceRevisits(places({0, 1, 0, 3, 4, 5}), m).wrong_closures == 1);
+  CHECK_THROWS_AS(scorePlaceRevisits({PlaceSpan{0, 60, 0}}, m), std::invalid_argument);
+}
+
+SCENARIO("GIVEN published frame matches WHEN they are judged by pose THEN near matches facing alike are right") {
+  std::vector<GroundPose> poses;
+  for (int i = 0; i < 10; ++i) poses.push_back(GroundPose{1.0 * i, 0.0, 0.0});
+  poses.push_back(GroundPose{0.5, 0.0, 0.0});                  // frame 10: back near frame 0
+  poses.push_back(GroundPose{5.0, 0.0, 3.141592653589793});    // frame 11: at frame 5, facing the other way
+  poses.push_back(GroundPose{});                                // frame 12: pose unknown
+  std::vector<std::int64_t> match(13, -1);
+  match[10] = 0;   // right (0.5 m)
+  match[11] = 5;   // wrong: turned round
+  match[12] = 3;   // not counted: unknown pose
+  match[9] = 2;    // wrong: 7 m away
+  const FrameMatchPoseScore s = scoreFrameMatchesByPose(match, poses);
+  CHECK(s.matches == 3);
+  CHECK(s.right == 1);
+  CHECK(s.wrong == 2);
+  CHECK(scoreFrameMatchesByPose(match, poses, 8.0, 1.0).right == 2);
+  CHECK_THROWS_AS(scoreFrameMatchesByPose(std::vector<std::int64_t>(3, -1), poses), std::invalid_argument);
+}

@@ -74,6 +74,8 @@ struct EvalResult {
   std::optional<TopologyScore> topology;
   /// Place revisits judged by the camera's pose; needs nodes and labels with x, y, heading (the simulator's).
   std::optional<PlaceRevisitScore> place_revisits;
+  /// The published frame matches judged by the camera's pose; needs frames.csv's match column and poses.
+  std::optional<FrameMatchPoseScore> frame_matches_by_pose;
   std::vector<double> best_topology_probability;  ///< per filter step, from topology.json
   std::vector<std::string> notes;                 ///< why a measure is missing, etc.
 };

@@ -192,11 +192,29 @@ struct PlaceRevisitScore {
   int merged_with_previous = 0;  ///< revisits left on the previous place's node, which they do not revisit
   int wrong_closures = 0;      ///< places on an earlier node (not the previous place's) none of whose places they revisit
   double radius_m = 0, max_heading_rad = 0, min_overlap = 0;
+  bool by_pose = true;  ///< false: judged by a loop-closure matrix (radius and heading unused)
 };
 
 /// place spans in time order; poses[f] for every frame (NaN: unknown, never covers nor counts).
 PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<GroundPose>& poses,
                                      double radius_m = 1.0, double max_heading_rad = 0.7853981633974483,
+                                     double min_overlap = 0.3);
+
+/// Each frame's published earlier frame judged by where the camera was (docs/evaluation.md, "Frame matches by
+/// pose"): right when it was taken within radius_m of the frame's position looking within max_heading_rad
+/// of its heading. A match to or from a frame of unknown pose is not counted.
+struct FrameMatchPoseScore {
+  std::int64_t matches = 0, right = 0, wrong = 0;
+  double radius_m = 0, max_heading_rad = 0;
+};
+
+/// match[f]: frame f's matched earlier frame (-1: none); poses[f] for every frame.
+FrameMatchPoseScore scoreFrameMatchesByPose(const std::vector<std::int64_t>& match, const std::vector<GroundPose>& poses,
+                                            double radius_m = 2.0, double max_heading_rad = 1.0);
+
+/// The same counts judged by a loop-closure matrix (a real set's ground truth): place j covers a frame f of
+/// place k when one of j's frames shows the same place as f (same.at(f, g)). same.size = the run's frames.
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const LoopClosureMatrix& same,
                                      double min_overlap = 0.3);
 
 /// The most frequent value >= 0 among values (smallest on ties), -1 when none.
