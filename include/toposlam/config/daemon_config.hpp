@@ -71,7 +71,7 @@ struct DaemonConfig {
   SegmentationStageConfig segmentation_stage;  ///< segmentation.motion.*
   TopologyFilterConfig topology;
   TopologyStageConfig topology_stage;          ///< topology.slice_items, topology.alternatives
-  SequenceEvidenceConfig sequence_evidence;  ///< topology.sequence_evidence.* (docs/topology.md); off by default
+  SequenceEvidenceConfig sequence_evidence;  ///< topology.sequence_evidence.* (docs/topology.md)
 
   DaemonConfig();
   /// "" or "<full.dotted.key>: <problem, allowed range>": every key's range and cross-key constraint of

@@ -121,8 +121,8 @@ struct SequenceEvidenceConfig {
   /// back at count as one place, so a third visit stands out as well as the second.
   double min_margin = 0.5;
   double distinct_s = 5.0;  ///< runs ending within this long of the best one are its own, not a runner-up
-  /// Likelihood of an earlier place every keyframe of the new place detects into; 0 = off (the default:
-  /// it closes look-alike stretches of one lap, docs/topology.md). 0.99 when turned on.
+  /// Likelihood of an earlier place every keyframe of the new place detects into; 0 = off (the thesis).
+  /// The default preset sets it (method_preset.cpp; chosen in docs/results.md).
   double weight = 0.0;
   /// The keyframe's own relative similarity z with the detected keyframe needed to count: a run's evidence
   /// fades slowly after the revisit ends, and without this the diagonal it leaves behind keeps voting.

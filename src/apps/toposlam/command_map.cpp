@@ -730,7 +730,7 @@ void addMapCommand(CLI::App& app) {
       ->check(keyRange("topology.sequence_evidence.keyframe_interval_s"));
   cmd->add_option("--sequence-evidence", options->sequence.weight,
                   "Filter: likelihood of an earlier place that every keyframe of the new place detects into (the "
-                  "sequence detector's evidence, docs/topology.md; 0 = off, 0.99 = on)")
+                  "sequence detector's evidence, docs/topology.md; 0 = off, as in the thesis)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--sequence-evidence-min-score", options->sequence.min_score,
