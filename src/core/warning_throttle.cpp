@@ -7,7 +7,11 @@
 namespace toposlam {
 
 WarningThrottle::WarningThrottle(std::string what, int first, double period_s, Sink sink, Now now)
-    : what_(std::move(what)), first_(first), period_s_(period_s), sink_(std::move(sink)), now_(std::move(now)) {
+    : what_(std::move(what)),
+      first_(first),
+      period_s_(period_s),
+      sink_(std::move(sink)),
+      now_(std::move(now)) {
   if (first_ < 0 || !(period_s_ > 0) || !sink_ || !now_)
     throw std::invalid_argument("WarningThrottle: first >= 0, period_s > 0, a sink and a clock are needed");
 }

@@ -43,9 +43,10 @@ TEST_CASE("GIVEN 5000 warnings at once WHEN the first 5 pass THEN 5 lines and on
   CHECK(h.lines[5] == "images: skipping bad files: 4995 more suppressed (5000 in all)");
 }
 
-TEST_CASE("GIVEN warnings once a second for 35 s WHEN the period is 10 s THEN a summary every 10 s and the rest at "
-          "destruction",
-          "[core][reliability]") {
+TEST_CASE(
+    "GIVEN warnings once a second for 35 s WHEN the period is 10 s THEN a summary every 10 s and the rest at "
+    "destruction",
+    "[core][reliability]") {
   Harness h;
   {
     WarningThrottle throttle("v4l2: skipped buffers", 2, 10.0, h.sink(), h.clock());
@@ -54,14 +55,16 @@ TEST_CASE("GIVEN warnings once a second for 35 s WHEN the period is 10 s THEN a 
       throttle.warn("skip " + std::to_string(s));
     }
   }
-  // 2 in full; suppressed from t = 2: summaries at t = 12 (11 warnings, 2..12), t = 23 (13..23), t = 34 (24..34).
+  // 2 in full; suppressed from t = 2: summaries at t = 12 (11 warnings, 2..12), t = 23 (13..23), t = 34
+  // (24..34).
   REQUIRE(h.lines.size() == 5);
   CHECK(h.lines[2] == "v4l2: skipped buffers: 11 more suppressed (13 in all)");
   CHECK(h.lines[3] == "v4l2: skipped buffers: 11 more suppressed (24 in all)");
   CHECK(h.lines[4] == "v4l2: skipped buffers: 11 more suppressed (35 in all)");
 }
 
-TEST_CASE("GIVEN fewer warnings than the first few WHEN flushed THEN no summary line", "[core][reliability]") {
+TEST_CASE("GIVEN fewer warnings than the first few WHEN flushed THEN no summary line",
+          "[core][reliability]") {
   Harness h;
   {
     WarningThrottle throttle("video: skipping frames", 3, 1.0, h.sink(), h.clock());

@@ -30,7 +30,7 @@ class WarningThrottle {
   /// Writes the summary of the warnings suppressed since the last one, if any.
   void flush();
 
-  std::int64_t total() const { return total_; }          ///< warnings seen
+  std::int64_t total() const { return total_; }            ///< warnings seen
   std::int64_t suppressed() const { return suppressed_; }  ///< of them, not passed through
   std::int64_t pending() const { return pending_; }        ///< suppressed and not yet summarised
 
