@@ -4,13 +4,14 @@
 #include <glob.h>
 
 #include <algorithm>
-#include <cstdlib>
-#include <cmath>
-#include <map>
 #include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -41,6 +42,29 @@ void sortFilesNaturally(std::vector<std::string>& files) {
     return naturalLess(a, b);
   });
 }
+
+SkipReason skipReasonOf(ImageReadError::Kind kind) {
+  switch (kind) {
+    case ImageReadError::Kind::Unreadable:
+      return SkipReason::Unreadable;
+    case ImageReadError::Kind::Truncated:
+      return SkipReason::Truncated;
+    case ImageReadError::Kind::TooLarge:
+      return SkipReason::TooLarge;
+    case ImageReadError::Kind::Corrupt:
+      break;
+  }
+  return SkipReason::Corrupt;
+}
+
+double steadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// Bad files named one by one: the first kSkipWarningsInFull, then a summary at most every
+/// kSkipSummaryPeriodS.
+constexpr int kSkipWarningsInFull = 5;
+constexpr double kSkipSummaryPeriodS = 10.0;
 
 }  // namespace
 
@@ -91,13 +115,16 @@ std::vector<std::string> listImageFiles(const std::string& path_or_glob) {
   return files;
 }
 
-ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz, std::int64_t max_pixels,
-                                   bool rate_given)
+ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double timestamp_rate_hz,
+                                   std::int64_t max_pixels, bool rate_given)
     : origin_(path_or_glob),
       files_(listImageFiles(path_or_glob)),
       rate_hz_(timestamp_rate_hz),
       max_pixels_(max_pixels),
-      rate_given_(rate_given) {
+      rate_given_(rate_given),
+      skip_warnings_(
+          "images: skipping bad files", kSkipWarningsInFull, kSkipSummaryPeriodS,
+          [](const std::string& line) { spdlog::warn("{}", line); }, steadySeconds) {
   if (!(rate_hz_ > 0)) throw FrameSourceError("images: rate must be > 0 Hz");
   if (max_pixels_ < 1) throw FrameSourceError("images: max_pixels must be >= 1");
   // The frames' own capture times, when a timestamps.csv (name,time_s) lies beside them (`toposlam sim`
@@ -172,13 +199,15 @@ std::optional<Frame> ImageFilesSource::next() {
     // One bad file (unreadable, truncated, over the pixel cap, undecodable) is dropped, counted and
     // named; it never ends the stream.
     cv::Mat image;
+    SkipReason reason = SkipReason::Corrupt;  // an image that decodes to nothing
     try {
       image = readImageFileChecked(file, ImageColor::Bgr, max_pixels_);
     } catch (const ImageReadError& e) {
-      spdlog::warn("images: skipping {}", e.what());
+      reason = skipReasonOf(e.kind());
+      skip_warnings_.warn(std::string("images: skipping ") + e.what());
     }
     if (image.empty()) {
-      ++skipped_;
+      ++skipped_[reason];
       continue;
     }
     Frame frame;
@@ -188,6 +217,7 @@ std::optional<Frame> ImageFilesSource::next() {
     frame.name = fs::path(file).filename().string();
     return frame;
   }
+  skip_warnings_.flush();  // the files ran out (or a stop): the count of what was not named
   return std::nullopt;
 }
 

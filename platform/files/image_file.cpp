@@ -100,21 +100,25 @@ std::optional<ImageHeader> readImageHeader(const unsigned char* data, std::size_
 
 cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, ImageColor color, std::int64_t max_pixels,
                          const std::string& name) {
-  if (bytes.empty()) throw ImageReadError(name + ": empty file");
+  if (bytes.empty()) throw ImageReadError(ImageReadError::Kind::Truncated, name + ": empty file");
   if (!imageBytesLookComplete(bytes))
-    throw ImageReadError(name + ": truncated (" + std::to_string(bytes.size()) + " bytes, no end marker)");
+    throw ImageReadError(ImageReadError::Kind::Truncated,
+                         name + ": truncated (" + std::to_string(bytes.size()) + " bytes, no end marker)");
   if (const auto header = readImageHeader(bytes.data(), bytes.size())) {
     // Each side is checked alone first: two sides near 2^32 would overflow the product (found by
     // fuzz_image_header; tests/fuzz/corpus/image_header/png-4g-sides).
     const bool side_too_long = header->width > max_pixels || header->height > max_pixels;
     const std::int64_t pixels = side_too_long ? std::numeric_limits<std::int64_t>::max() : header->width * header->height;
     if (header->width == 0 || header->height == 0)
-      throw ImageReadError(name + ": " + header->format + " header says " + std::to_string(header->width) + "x" +
-                           std::to_string(header->height) + " pixels");
+      throw ImageReadError(ImageReadError::Kind::Corrupt, name + ": " + header->format + " header says " +
+                                                              std::to_string(header->width) + "x" +
+                                                              std::to_string(header->height) + " pixels");
     if (pixels > max_pixels)
-      throw ImageReadError(name + ": " + std::to_string(header->width) + "x" + std::to_string(header->height) +
-                           " pixels (" + (side_too_long ? std::string("a side alone") : megapixels(pixels)) + ") is over the cap of " + megapixels(max_pixels) +
-                           " (max_pixels); not decoded");
+      throw ImageReadError(
+          ImageReadError::Kind::TooLarge,
+          name + ": " + std::to_string(header->width) + "x" + std::to_string(header->height) + " pixels (" +
+              (side_too_long ? std::string("a side alone") : megapixels(pixels)) + ") is over the cap of " +
+              megapixels(max_pixels) + " (max_pixels); not decoded");
   }
   cv::Mat image;
   try {
@@ -122,11 +126,12 @@ cv::Mat decodeImageBytes(const std::vector<unsigned char>& bytes, ImageColor col
     // later, in a DNL marker, is only known there).
     image = decodeImage(bytes.data(), bytes.size(), color, max_pixels);
   } catch (const ImageCodecError& e) {
-    throw ImageReadError(name + ": not a readable image (corrupt or unsupported format): " + e.what());
+    throw ImageReadError(ImageReadError::Kind::Corrupt,
+                         name + ": not a readable image (corrupt or unsupported format): " + e.what());
   } catch (const cv::Exception& e) {
-    throw ImageReadError(name + ": cannot decode it (" + e.err + ")");
+    throw ImageReadError(ImageReadError::Kind::Corrupt, name + ": cannot decode it (" + e.err + ")");
   } catch (const std::bad_alloc&) {
-    throw ImageReadError(name + ": cannot decode it (out of memory)");
+    throw ImageReadError(ImageReadError::Kind::TooLarge, name + ": cannot decode it (out of memory)");
   }
   return image;
 }
@@ -135,17 +140,21 @@ cv::Mat readImageFileChecked(const std::string& path, ImageColor color, std::int
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error = errno;
-    throw ImageReadError(path + ": " + (error == ENOENT ? std::string("no such file") : std::strerror(error)));
+    throw ImageReadError(
+        ImageReadError::Kind::Unreadable,
+        path + ": " + (error == ENOENT ? std::string("no such file") : std::strerror(error)));
   }
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     const bool folder = S_ISDIR(st.st_mode);
     ::close(fd);
-    throw ImageReadError(path + (folder ? ": is a folder, not an image" : ": not a regular file"));
+    throw ImageReadError(ImageReadError::Kind::Unreadable,
+                         path + (folder ? ": is a folder, not an image" : ": not a regular file"));
   }
   if (static_cast<std::uint64_t>(st.st_size) > kMaxImageFileBytes) {
     ::close(fd);
-    throw ImageReadError(path + ": " + std::to_string(st.st_size) + " bytes is too large for an image file");
+    throw ImageReadError(ImageReadError::Kind::TooLarge,
+                         path + ": " + std::to_string(st.st_size) + " bytes is too large for an image file");
   }
   std::vector<unsigned char> bytes(static_cast<std::size_t>(st.st_size));
   std::size_t done = 0;
@@ -158,7 +167,8 @@ cv::Mat readImageFileChecked(const std::string& path, ImageColor color, std::int
   const int read_error = errno;
   ::close(fd);
   if (done != bytes.size())
-    throw ImageReadError(path + ": cannot read it (" + std::string(std::strerror(read_error)) + ")");
+    throw ImageReadError(ImageReadError::Kind::Unreadable,
+                         path + ": cannot read it (" + std::string(std::strerror(read_error)) + ")");
   return decodeImageBytes(bytes, color, max_pixels, path);
 }
 

@@ -82,6 +82,7 @@ class RateLimitedSource : public FrameSource {
   FrameSourceState state() const override { return inner_->state(); }
   bool realTime() const override { return true; }  // frames come when due, not when asked for
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
+  SkippedFrames skippedByReason() const override { return inner_->skippedByReason(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
   std::string frameName(std::int64_t sequence) const override { return inner_->frameName(sequence); }
   std::optional<std::int64_t> continueAfter(std::int64_t last_sequence, const std::string& last_name) override {

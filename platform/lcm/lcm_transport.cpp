@@ -24,8 +24,9 @@
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
 #include "toposlam_lcm/place_v1_t.hpp"
-#include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_t.hpp"
+#include "toposlam_lcm/status_v1_t.hpp"
+#include "toposlam_lcm/status_v2_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
 namespace toposlam {
@@ -225,6 +226,14 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.motion_standing_frames = motion_ ? motion_->standing_frames.load() : 0;
   msg.motion_refused = motion_ ? motion_->refused.load() : 0;
   msg.motion_malformed = motion_ ? motion_->malformed.load() : 0;
+  const SkippedFrames& skipped = s.source_skipped_by_reason;
+  msg.source_skipped_unreadable = skipped[SkipReason::Unreadable];
+  msg.source_skipped_truncated = skipped[SkipReason::Truncated];
+  msg.source_skipped_corrupt = skipped[SkipReason::Corrupt];
+  msg.source_skipped_too_large = skipped[SkipReason::TooLarge];
+  msg.source_skipped_wrong_format = skipped[SkipReason::WrongFormat];
+  msg.source_skipped_device_error = skipped[SkipReason::DeviceError];
+  msg.source_skipped_other = skipped[SkipReason::Other];
   msg.num_stages = static_cast<std::int32_t>(s.stages.size());
   msg.stages.reserve(s.stages.size());
   for (const StageStatus& st : s.stages) {
@@ -332,8 +341,18 @@ const WireSchema kPlace = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fix
 const WireSchema kPlaceV1 = {fixed(8 * 3 + 4 * 4 + 1 + 4), length(), array(8), fixed(8)};  // before match_*
 const WireSchema kPlaceEvent = {fixed(8 + 4 + 4 + 1 + 4 + 8 * 3 + 4 * 3), length(), array(1), fixed(8)};
 const WireSchema kStageStatus = {text(), fixed(4 * 3 + 8 * 2 + 4 * 2 + 4)};
-const WireSchema kStatus = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
-                            text(), fixed(8 + 8 + 8), length(), array(kStageStatus)};
+const WireSchema kStatus = {fixed(8),
+                            text(),
+                            fixed(4 + 4 + 8 * 5),
+                            text(),
+                            fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
+                            text(),
+                            fixed(8 + 8 + 8 + 8 * 7),
+                            length(),
+                            array(kStageStatus)};
+const WireSchema kStatusV2 = {
+    fixed(8),         text(),   fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3), text(),
+    fixed(8 + 8 + 8), length(), array(kStageStatus)};  // before source_skipped_*
 const WireSchema kStatusV1 = {fixed(8), text(), fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
                               text(), fixed(8), length(), array(kStageStatus)};  // before motion_refused
 const WireSchema kTopologyNode = {fixed(4), length(), array(4), length(), array(8)};
@@ -380,13 +399,24 @@ bool decodePlaceMessage(const void* data, std::size_t size, toposlam_lcm::place_
 
 namespace {
 
-/// A TOPOSLAM_STATUS message as status_t or, failing that, as status_v1_t (recorded before motion_refused
-/// existed; it then reads 0).
-bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::status_t& out) {
-  if (decodeMessage(data, size, out, "status")) return true;
-  toposlam_lcm::status_v1_t old{};
-  if (!decodeMessage(data, size, old, "status_v1")) return false;
-  out = toposlam_lcm::status_t{};
+/// A status message's source_skipped_<reason> as SkippedFrames.
+SkippedFrames skippedFramesOf(const toposlam_lcm::status_t& m) {
+  SkippedFrames skipped;
+  skipped[SkipReason::Unreadable] = m.source_skipped_unreadable;
+  skipped[SkipReason::Truncated] = m.source_skipped_truncated;
+  skipped[SkipReason::Corrupt] = m.source_skipped_corrupt;
+  skipped[SkipReason::TooLarge] = m.source_skipped_too_large;
+  skipped[SkipReason::WrongFormat] = m.source_skipped_wrong_format;
+  skipped[SkipReason::DeviceError] = m.source_skipped_device_error;
+  skipped[SkipReason::Other] = m.source_skipped_other;
+  return skipped;
+}
+
+/// The fields every version of status_t has, from an older recording's message; the newer ones read 0, and
+/// the frames the source skipped are all "other" (the reason was not recorded).
+template <typename OldStatus>
+toposlam_lcm::status_t statusFromOld(const OldStatus& old) {
+  toposlam_lcm::status_t out{};
   out.utime = old.utime;
   out.state = old.state;
   out.uptime_s = old.uptime_s;
@@ -396,6 +426,7 @@ bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::statu
   out.frames_dropped = old.frames_dropped;
   out.queue_kept_waits = old.queue_kept_waits;
   out.source_skipped = old.source_skipped;
+  out.source_skipped_other = old.source_skipped;
   out.source_state = old.source_state;
   out.source_reconnects = old.source_reconnects;
   out.source_reconnect_attempts = old.source_reconnect_attempts;
@@ -410,10 +441,25 @@ bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::statu
   out.motion_messages = old.motion_messages;
   out.motion_state = old.motion_state;
   out.motion_standing_frames = old.motion_standing_frames;
-  out.motion_refused = 0;
-  out.motion_malformed = 0;
   out.num_stages = old.num_stages;
   out.stages = old.stages;
+  return out;
+}
+
+/// A TOPOSLAM_STATUS message as status_t or, failing that, as status_v2_t (recorded before
+/// source_skipped_<reason> existed) or status_v1_t (before motion_refused and motion_malformed too; they then
+/// read 0).
+bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::status_t& out) {
+  if (decodeMessage(data, size, out, "status")) return true;
+  if (toposlam_lcm::status_v2_t v2{}; decodeMessage(data, size, v2, "status_v2")) {
+    out = statusFromOld(v2);
+    out.motion_refused = v2.motion_refused;
+    out.motion_malformed = v2.motion_malformed;
+    return true;
+  }
+  toposlam_lcm::status_v1_t v1{};
+  if (!decodeMessage(data, size, v1, "status_v1")) return false;
+  out = statusFromOld(v1);
   return true;
 }
 
@@ -425,6 +471,7 @@ bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t s
                              : kind == "place_event" ? &kPlaceEvent
                              : kind == "status"      ? &kStatus
                              : kind == "status_v1"   ? &kStatusV1
+                             : kind == "status_v2"   ? &kStatusV2
                              : kind == "topology"    ? &kTopology
                              : kind == "motion"      ? &kMotion
                                                      : nullptr;
@@ -571,15 +618,26 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
     }
   } else if (kind == "status") {
     toposlam_lcm::status_t m{};
-    ok = decodeStatusMessage(data, size, m);  // recordings from before motion_refused: status_v1_t
+    ok = decodeStatusMessage(data, size, m);  // older recordings: status_v2_t, status_v1_t
     if (ok) {
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);
-      w.field("frames_captured", m.frames_captured).field("frames_published", m.frames_published)
-          .field("frames_dropped", m.frames_dropped).field("queue_kept_waits", m.queue_kept_waits)
+      w.field("frames_captured", m.frames_captured)
+          .field("frames_published", m.frames_published)
+          .field("frames_dropped", m.frames_dropped)
+          .field("queue_kept_waits", m.queue_kept_waits)
           .field("source_state", m.source_state)
-          .field("source_reconnects", m.source_reconnects).field("source_reconnect_attempts", m.source_reconnect_attempts)
-          .field("source_dropped", m.source_dropped);
+          .field("source_reconnects", m.source_reconnects)
+          .field("source_reconnect_attempts", m.source_reconnect_attempts)
+          .field("source_dropped", m.source_dropped)
+          .field("source_skipped", m.source_skipped)
+          .field("source_skipped_unreadable", m.source_skipped_unreadable)
+          .field("source_skipped_truncated", m.source_skipped_truncated)
+          .field("source_skipped_corrupt", m.source_skipped_corrupt)
+          .field("source_skipped_too_large", m.source_skipped_too_large)
+          .field("source_skipped_wrong_format", m.source_skipped_wrong_format)
+          .field("source_skipped_device_error", m.source_skipped_device_error)
+          .field("source_skipped_other", m.source_skipped_other);
       jsonNumber(w, "latency_median_ms", m.latency_median_ms);
       jsonNumber(w, "latency_p99_ms", m.latency_p99_ms);
       jsonNumber(w, "latency_max_ms", m.latency_max_ms);
@@ -609,6 +667,8 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
                     m.source_state.c_str(), static_cast<long long>(m.source_reconnects),
                     static_cast<long long>(m.source_dropped));
       out.summary = line;
+      if (const std::string skipped = skippedFramesText(skippedFramesOf(m)); !skipped.empty())
+        out.summary += "  " + skipped;
       if (const std::string motion = motionStatusText(m.motion_state, m.motion_standing_frames, m.motion_refused,
                                                           m.motion_malformed);
           !motion.empty())

@@ -140,6 +140,7 @@ struct LibcameraFrameSource::Impl : std::enable_shared_from_this<Impl> {
   bool stop_requested = false;
   std::int64_t dropped = 0;
   std::int64_t skipped = 0;
+  std::int64_t failed_requests = 0;  ///< of skipped: completed with an error status or no plane
   std::int64_t delivered = 0;
   /// When the last frame (or the start) was, for the no-frame timeout; touched by next() only.
   std::chrono::steady_clock::time_point last_frame_at = std::chrono::steady_clock::now();
@@ -287,6 +288,14 @@ std::int64_t LibcameraFrameSource::skippedFrames() const {
   return impl_->skipped;
 }
 
+SkippedFrames LibcameraFrameSource::skippedByReason() const {
+  std::lock_guard lock(impl_->mutex);
+  SkippedFrames skipped;
+  skipped[SkipReason::DeviceError] = impl_->failed_requests;
+  skipped[SkipReason::Corrupt] = impl_->skipped - impl_->failed_requests;
+  return skipped;
+}
+
 std::int64_t LibcameraFrameSource::droppedFrames() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->dropped;
@@ -340,6 +349,7 @@ SourceWait LibcameraFrameSource::nextFor(std::chrono::milliseconds timeout, Fram
     if (metadata.status != libcamera::FrameMetadata::FrameSuccess || metadata.planes().size() == 0) {
       std::lock_guard lock(impl.mutex);
       ++impl.skipped;
+      ++impl.failed_requests;
       impl.requeueLocked(request);
       return SourceWait::Timeout;  // skipped (counted)
     }

@@ -70,6 +70,8 @@ class LibcameraFrameSource : public FrameSource {
   FrameSourceState state() const override;  ///< always streaming; `dropped` = requests re-queued unseen
   bool realTime() const override { return true; }
   std::int64_t skippedFrames() const override;
+  /// Requests the camera failed (DeviceError) and buffers that did not convert or decode (Corrupt).
+  SkippedFrames skippedByReason() const override;
   std::int64_t droppedFrames() const;
 
   struct Impl;  // libcamera objects, kept out of this header; shared with frame leases

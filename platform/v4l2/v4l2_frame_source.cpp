@@ -248,6 +248,15 @@ std::int64_t V4l2FrameSource::skippedFrames() const {
   return status_.skipped;
 }
 
+SkippedFrames V4l2FrameSource::skippedByReason() const {
+  std::lock_guard lock(status_mutex_);
+  SkippedFrames skipped;
+  skipped[SkipReason::DeviceError] = status_.error_buffers;
+  skipped[SkipReason::Truncated] = status_.short_buffers;
+  skipped[SkipReason::Corrupt] = status_.decode_failures;
+  return skipped;
+}
+
 FrameSourceState V4l2FrameSource::state() const {
   std::lock_guard lock(status_mutex_);
   FrameSourceState state;

@@ -139,6 +139,9 @@ class V4l2FrameSource : public FrameSource {
   FrameSourceState state() const override;
   bool realTime() const override { return true; }
   std::int64_t skippedFrames() const override;
+  /// Error-flagged buffers (DeviceError), short or empty ones (Truncated), MJPEG that did not decode
+  /// (Corrupt).
+  SkippedFrames skippedByReason() const override;
   std::int64_t droppedFrames() const;
   V4l2SourceStatus status() const;
 

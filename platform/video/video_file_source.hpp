@@ -24,6 +24,12 @@ class VideoFileSource : public FrameSource {
   std::optional<Frame> next() override;
   void interrupt() override { interrupted_.store(true); }
   std::int64_t skippedFrames() const override { return skipped_; }
+  /// Frames of an unexpected pixel type (all of them WrongFormat).
+  SkippedFrames skippedByReason() const override {
+    SkippedFrames skipped;
+    skipped[SkipReason::WrongFormat] = skipped_;
+    return skipped;
+  }
   std::int64_t frameCountHint() const override { return frame_count_; }
 
  private:

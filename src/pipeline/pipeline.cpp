@@ -99,6 +99,8 @@ std::string statusLine(const PipelineStatus& s) {
                 s.state.c_str(), s.fps, s.latency.p99_ms, s.places, static_cast<long long>(s.map_revision),
                 static_cast<long long>(s.frames_dropped), static_cast<long long>(s.queue_kept_waits), camera);
   std::string line = text;
+  if (const std::string skipped = skippedFramesText(s.source_skipped_by_reason); !skipped.empty())
+    line += "; " + skipped;
   if (s.map_save_failures > 0)
     line += "; map save failing (" + std::to_string(s.map_save_failures) + " in a row, retrying; the previous map is kept): " +
             s.map_save_problem;
@@ -261,8 +263,12 @@ void Pipeline::captureLoop() {
       // Bounded wait: a silent or reconnecting camera still lets this thread beat and see a stop.
       const SourceWait wait = source_.nextFor(kPollPeriod, frame);
       const FrameSourceState state = source_.state();
-      if (const std::int64_t skipped = source_.skippedFrames(); skipped > source_skipped_.exchange(skipped))
+      if (const std::int64_t skipped = source_.skippedFrames(); skipped > source_skipped_.exchange(skipped)) {
         last_frame_failed_s_.store(clock_.now());  // the source skipped a frame (a bad file, an error buffer)
+        const SkippedFrames by_reason = source_.skippedByReason();
+        for (std::size_t r = 0; r < kSkipReasonCount; ++r)
+          source_skipped_by_reason_[r].store(by_reason.count[r]);
+      }
       source_reconnecting_.store(state.link == SourceLink::Reconnecting);
       source_reconnects_.store(state.reconnects);
       source_reconnect_attempts_.store(state.reconnect_attempts);
@@ -562,6 +568,8 @@ StatusCounters Pipeline::statusCounters(std::int64_t published) const {
   c.process_cpu_s = processCpuSeconds();
   c.frames_captured = processed_[kCapture].load();
   c.source_skipped = source_skipped_.load();
+  for (std::size_t r = 0; r < kSkipReasonCount; ++r)
+    c.source_skipped_by_reason.count[r] = source_skipped_by_reason_[r].load();
   c.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
   c.source_reconnects = source_reconnects_.load();
   c.source_reconnect_attempts = source_reconnect_attempts_.load();

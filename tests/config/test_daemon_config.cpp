@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <fstream>
+#include <sstream>
 
 #include <string>
 #include <utility>
@@ -22,6 +24,13 @@ std::string errorOf(const std::string& yaml) {
     return e.what();
   }
   return "";
+}
+
+std::string fileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 }  // namespace
@@ -255,4 +264,49 @@ SCENARIO("GIVEN a 1 KB YAML alias bomb WHEN the config is read THEN it is refuse
   const auto start = std::chrono::steady_clock::now();
   CHECK_THROWS_WITH(parseDaemonConfig(bomb, "bomb.yaml"), Catch::Contains("bomb.yaml: line 2: aliases (*name) are not allowed"));
   CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(2));  // minutes before; about 1 ms now
+}
+
+SCENARIO("GIVEN the fuzz corpus's alias and octal-looking configs WHEN each is read THEN aliases are refused at once "
+         "and numbers with a leading zero are refused") {
+  // The checked-in seeds of fuzz_config (tests/fuzz/corpus/config, made by fuzz_make_seeds): this keeps them
+  // meaningful, and fuzz_replay_config replays them (and every past finding) in every build.
+  const std::string corpus = std::string(TOPOSLAM_SOURCE_DIR) + "/tests/fuzz/corpus/config/";
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"alias_bomb", "alias_bomb: line 2: aliases (*name) are not allowed"},
+      {"alias_nested", "alias_nested: line 2: aliases (*name) are not allowed"},
+      {"alias_merge_key", "alias_merge_key: line 3: aliases (*name) are not allowed"},
+      {"alias_merge_list", "alias_merge_list: line 4: aliases (*name) are not allowed"},
+      {"alias_as_key", "alias_as_key: line 2: aliases (*name) are not allowed"},
+      {"alias_undefined", "alias_undefined: not valid YAML"},
+      {"alias_second_document", "alias_second_document: holds 2 YAML documents"},
+      {"octal_leading_zero", "topology.particles: '010' has a leading zero"},
+      {"octal_signed", "pipeline.queues.frames: '-010' has a leading zero"},
+      {"octal_0o", "topology.particles: expected an integer"},
+  };
+  for (const auto& [name, expected] : refused) {
+    WHEN(name + " is read") {
+      const std::string text = fileText(corpus + name);
+      REQUIRE_FALSE(text.empty());
+      const auto start = std::chrono::steady_clock::now();
+      std::string error;
+      try {
+        (void)parseDaemonConfig(text, name);
+      } catch (const ConfigError& e) {
+        error = e.what();
+      }
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      THEN("it is refused: " + expected) {
+        CHECK_THAT(error, Catch::Contains(expected));
+        CHECK(ms < 1000.0);  // about 0.1 ms; the alias bomb took minutes before issue 41
+      }
+    }
+  }
+  WHEN("an anchor with no alias, a hexadecimal count and a real with a leading zero are read") {
+    auto read = [&](const std::string& name) { return parseDaemonConfig(fileText(corpus + name), name); };
+    THEN("they mean what both YAML versions agree on") {
+      CHECK(read("anchor_only").topology.particles == 50);
+      CHECK(read("hexadecimal").topology.particles == 16);
+      CHECK(read("real_leading_zero").segmentation.window_s == 6.5);
+    }
+  }
 }

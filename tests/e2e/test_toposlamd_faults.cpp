@@ -194,6 +194,38 @@ SCENARIO("GIVEN temporary files a kill -9 left and a frame claiming 65500x65500 
   CHECK(fs::exists(map));
 }
 
+SCENARIO(
+    "GIVEN a folder of 4 good frames, 30 truncated files and 2 claiming 65500x65500 WHEN toposlamd plays it "
+    "THEN the 32 are counted by reason, 5 are named in the log and one line sums up the other 27") {
+  const fs::path dir = freshDirectory("bad-files");
+  const fs::path frames = sampleFolder(dir, 4);
+  const std::string jpeg = readText(frames / "1.jpg");
+  for (int i = 0; i < 30; ++i)  // cut after 200 bytes: no end marker
+    std::ofstream(frames / std::string("t").append(std::to_string(i)).append(".jpg"), std::ios::binary)
+        << jpeg.substr(0, 200);
+  std::string huge = jpeg;
+  const std::size_t sof = huge.find("\xFF\xC0");
+  REQUIRE(sof != std::string::npos);
+  huge[sof + 5] = huge[sof + 7] = '\xFF';
+  huge[sof + 6] = huge[sof + 8] = '\xDC';  // 65500 = 0xFFDC
+  for (int i = 0; i < 2; ++i)
+    std::ofstream(frames / std::string("h").append(std::to_string(i)).append(".jpg"), std::ios::binary)
+        << huge;
+  const int code = runDaemon(dir / "run.log", daemonArgs(frames, dir / "map.tsm"));
+  const std::string log = readText(dir / "run.log");
+  INFO(log);
+  CHECK(code == 0);
+  CHECK_THAT(log, Catch::Contains("4 frames published") &&
+                      Catch::Contains("skipped 32 frames (truncated 30, too large 2)"));
+  std::size_t named = 0, summaries = 0;
+  for (std::size_t at = log.find("images: skipping "); at != std::string::npos;
+       at = log.find("images: skipping ", at + 1))
+    ++(log.compare(at, 36, "images: skipping bad files: 27 more ") == 0 ? summaries : named);
+  CHECK(named == 5 + 1);  // the fifth line also says "(images: skipping bad files: further ones are ...)"
+  CHECK(summaries == 1);
+  CHECK_THAT(log, Catch::Contains("images: skipping bad files: 27 more suppressed (32 in all)"));
+}
+
 SCENARIO("GIVEN a map made with ORB keypoints WHEN toposlamd resumes it with SIFT THEN it refuses naming both") {
   const fs::path dir = freshDirectory("settings");
   const fs::path frames = sampleFolder(dir, 3);

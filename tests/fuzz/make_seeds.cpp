@@ -36,6 +36,18 @@ std::string encoded(char kind, const Message& m) {
   return std::string(1, kind) + bytes;
 }
 
+// "Billion laughs" in YAML: a0 lists ten x, each next level ten aliases of the one before (1e9 leaves at a8).
+std::string configAliasBomb() {
+  std::string bomb = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int level = 1; level < 9; ++level) {
+    const std::string name = std::to_string(level), before = std::to_string(level - 1);
+    bomb.append("a").append(name).append(": &a").append(name).append(" [");
+    for (int i = 0; i < 10; ++i) bomb.append(i ? ", *a" : "*a").append(before);
+    bomb += "]\n";
+  }
+  return bomb;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,6 +71,26 @@ int main(int argc, char** argv) {
   write(out / "config" / "small", "source: images:frames\nmap:\n  path: m.tsm\n  save_period_s: 5\n");
   write(out / "config" / "nested", "pipeline:\n  queues: {frames: 4, overflow: block}\ntopology: {particles: 50}\n");
   write(out / "config" / "two_documents", "source: images:a\n---\nsource: images:b\n");
+  // Aliases, all refused before the document is built (issue 41): a billion-laughs bomb (nine levels of
+  // ten aliases, 1e9 leaves if expanded), aliases of aliases, merge keys, an alias as a key, an alias of
+  // nothing, and an alias in a second document; an anchor alone is harmless.
+  write(out / "config" / "alias_bomb", configAliasBomb());
+  write(out / "config" / "alias_nested",
+        "q: &q {frames: 4, overflow: block}\nqueues: &queues {queues: *q}\npipeline: *queues\n");
+  write(out / "config" / "alias_merge_key",
+        "base: &base {particles: 50, seed: 3}\ntopology:\n  <<: *base\n  particles: 60\n");
+  write(out / "config" / "alias_merge_list",
+        "a: &a {particles: 50}\nb: &b {seed: 3}\ntopology:\n  <<: [*a, *b]\n");
+  write(out / "config" / "alias_as_key", "k: &k source\n*k : images:frames\n");
+  write(out / "config" / "alias_undefined", "topology: *nowhere\n");
+  write(out / "config" / "alias_second_document", "source: images:a\n---\nx: &x 1\ny: *x\n");
+  write(out / "config" / "anchor_only", "topology: &t {particles: 50}\n");
+  // Octal-looking numbers (YAML 1.1 reads 010 as 8): refused with a leading zero, others as not integers.
+  write(out / "config" / "octal_leading_zero", "topology: {particles: 010}\n");
+  write(out / "config" / "octal_signed", "pipeline:\n  queues: {frames: -010}\ntopology: {particles: +010}\n");
+  write(out / "config" / "octal_0o", "topology: {particles: 0o10}\n");
+  write(out / "config" / "hexadecimal", "topology: {particles: 0x10}\n");
+  write(out / "config" / "real_leading_zero", "segmentation: {window_s: 06.5}\n");
 
   // Fingerprints of a real frame, with ORB and SIFT keypoints.
   const cv::Mat frame = cv::imread(std::string(TOPOSLAM_SAMPLES_DIR) + "/samples/1.jpg", cv::IMREAD_COLOR);

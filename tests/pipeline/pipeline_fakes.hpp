@@ -27,6 +27,8 @@ class FakeSource final : public FrameSource {
   std::string describe() const override { return "fake"; }
   void interrupt() override { interrupted.store(true); }
   bool realTime() const override { return real_time; }
+  std::int64_t skippedFrames() const override { return skipped.total(); }
+  SkippedFrames skippedByReason() const override { return skipped; }
   std::optional<Frame> next() override {
     if (interrupted.load()) return std::nullopt;
     if (count_ >= 0 && produced_ >= count_) {
@@ -47,6 +49,8 @@ class FakeSource final : public FrameSource {
   std::function<void(std::int64_t)> before_frame;
   std::function<void()> on_end;
   bool real_time = false;  ///< what realTime() says (a camera, a file played with ?rate=)
+  SkippedFrames
+      skipped;  ///< what skippedByReason() says; change it only from before_frame (the capture thread)
   std::atomic<int> released{0};
   std::atomic<bool> interrupted{false};
 

@@ -677,6 +677,31 @@ SCENARIO("The status line names the camera state") {
   CHECK_THAT(statusLine(s), Catch::EndsWith("camera reconnecting (attempt 1, 1 reconnects, 0 lost by the driver)"));
 }
 
+SCENARIO(
+    "GIVEN a source that skips 10 frames, 5 corrupt and 5 truncated WHEN the pipeline runs THEN the status "
+    "counts them by reason and the status line says so") {
+  ManualClock clock;
+  FakeSource source(30);
+  source.before_frame = [&](std::int64_t i) {
+    if (i % 3 == 0) ++source.skipped[i % 2 == 0 ? SkipReason::Corrupt : SkipReason::Truncated];
+  };
+  FakeFingerprint fingerprint;
+  FakeSegmentation segmentation(10);
+  FakeTopology topology(clock, 1, 1e-3);
+  RecordingSink sink;
+  Pipeline pipeline(losslessConfig(), savedAtStop(), patientWatchdog(), source, fingerprint, segmentation,
+                    topology, sink, clock);
+  pipeline.start();
+  pipeline.wait();
+  REQUIRE_FALSE(sink.statuses.empty());
+  const PipelineStatus& last = sink.statuses.back();
+  CHECK(last.source_skipped == 10);
+  CHECK(last.source_skipped_by_reason[SkipReason::Corrupt] == 5);
+  CHECK(last.source_skipped_by_reason[SkipReason::Truncated] == 5);
+  CHECK(last.source_skipped_by_reason.total() == 10);
+  CHECK_THAT(statusLine(last), Catch::EndsWith("; skipped 10 frames (truncated 5, corrupt 5)"));
+}
+
 SCENARIO("GIVEN a disk that refuses the final map save WHEN the pipeline stops THEN the save is tried again, and "
          "one that never works is an error that names it") {
   ManualClock clock;

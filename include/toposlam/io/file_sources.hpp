@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "toposlam/core/warning_throttle.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
 
@@ -36,7 +37,9 @@ class ImageFilesSource : public FrameSource {
   std::string describe() const override;
   std::optional<Frame> next() override;
   void interrupt() override { interrupted_.store(true); }
-  std::int64_t skippedFrames() const override { return skipped_; }
+  std::int64_t skippedFrames() const override { return skipped_.total(); }
+  /// Unreadable, truncated, corrupt or over the caps (ImageReadError::Kind).
+  SkippedFrames skippedByReason() const override { return skipped_; }
   std::int64_t frameCountHint() const override { return static_cast<std::int64_t>(files_.size()); }
   /// The file name (without its folder) of file `sequence`; "" out of range.
   std::string frameName(std::int64_t sequence) const override;
@@ -54,7 +57,10 @@ class ImageFilesSource : public FrameSource {
   std::vector<double> times_;    ///< per file, from timestamps.csv beside the files; empty = index / rate
   std::string timestamps_file_;  ///< that file, for describe()
   std::size_t next_index_ = 0;
-  std::int64_t skipped_ = 0;
+  SkippedFrames skipped_;
+  // One warning per bad file for the first few, then summaries (a folder of 5,000 bad files gave 4,900
+  // lines); the last summary when the files run out.
+  WarningThrottle skip_warnings_;
   std::atomic<bool> interrupted_{false};
 };
 

@@ -24,9 +24,20 @@ inline constexpr std::int64_t kDefaultMaxImagePixels = 4096LL * 4096LL;
 /// Files larger than this are not read (bytes).
 inline constexpr std::uint64_t kMaxImageFileBytes = 256ull << 20;
 
+/// A file that cannot be used as an image; kind() says why (a frame source counts it by reason).
 class ImageReadError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  enum class Kind {
+    Unreadable,  ///< cannot be opened or read, or not a regular file
+    Truncated,   ///< empty, or cut short (no end marker)
+    Corrupt,     ///< the header or the decoder refused it (corrupt data, unsupported format)
+    TooLarge,    ///< over the pixel cap or the file-size cap
+  };
+  ImageReadError(Kind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
 };
 
 struct ImageHeader {

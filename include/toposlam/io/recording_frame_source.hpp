@@ -70,6 +70,7 @@ class RecordingFrameSource final : public FrameSource {
   FrameSourceState state() const override { return inner_->state(); }
   bool realTime() const override { return inner_->realTime(); }
   std::int64_t skippedFrames() const override { return inner_->skippedFrames(); }
+  SkippedFrames skippedByReason() const override { return inner_->skippedByReason(); }
   std::int64_t frameCountHint() const override { return inner_->frameCountHint(); }
   std::string frameName(std::int64_t sequence) const override { return inner_->frameName(sequence); }
   std::optional<std::int64_t> continueAfter(std::int64_t last_sequence, const std::string& last_name) override {

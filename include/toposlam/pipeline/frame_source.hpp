@@ -8,6 +8,7 @@
 // (streaming or reconnecting, and its counters), from any thread.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -31,6 +32,51 @@ struct Frame {
   /// Keeps a zero-copy buffer alive; releasing it hands the buffer back to the source.
   std::shared_ptr<void> buffer_lease;
 };
+
+/// Why a source skipped a frame (status_t's source_skipped_<reason>, docs/daemon.md).
+enum class SkipReason {
+  Unreadable,   ///< a file that cannot be opened or read (permissions, a folder, an I/O error)
+  Truncated,    ///< an empty or cut-short file (no end marker), a camera buffer shorter than the image
+  Corrupt,      ///< the decoder refused it or reported corrupt data (a damaged JPEG, an undecodable MJPEG)
+  TooLarge,     ///< over the pixel cap (max_pixels) or the file-size cap; not decoded
+  WrongFormat,  ///< a frame of an unexpected pixel type or size from a video or a camera
+  DeviceError,  ///< the driver or camera flagged the buffer as failed
+  Other,        ///< a source that does not tell why (a plug-in source)
+};
+inline constexpr std::size_t kSkipReasonCount = 7;
+inline const char* toString(SkipReason reason) {
+  static constexpr const char* kNames[kSkipReasonCount] = {
+      "unreadable", "truncated", "corrupt", "too large", "wrong format", "device error", "other"};
+  return kNames[static_cast<std::size_t>(reason)];
+}
+
+/// Frames a source skipped, counted by reason. A plain value.
+struct SkippedFrames {
+  std::array<std::int64_t, kSkipReasonCount> count{};
+  std::int64_t& operator[](SkipReason reason) { return count[static_cast<std::size_t>(reason)]; }
+  std::int64_t operator[](SkipReason reason) const { return count[static_cast<std::size_t>(reason)]; }
+  std::int64_t total() const {
+    std::int64_t sum = 0;
+    for (std::int64_t n : count) sum += n;
+    return sum;
+  }
+};
+
+/// The skipped part of a status line: "skipped 12 frames (truncated 10, corrupt 2)", reasons with a count in
+/// SkipReason's order; "" when none was skipped.
+inline std::string skippedFramesText(const SkippedFrames& skipped) {
+  if (skipped.total() == 0) return "";
+  std::string text =
+      "skipped " + std::to_string(skipped.total()) + (skipped.total() == 1 ? " frame (" : " frames (");
+  bool first = true;
+  for (std::size_t r = 0; r < kSkipReasonCount; ++r) {
+    if (skipped.count[r] == 0) continue;
+    text += (first ? "" : ", ") + std::string(toString(static_cast<SkipReason>(r))) + " " +
+            std::to_string(skipped.count[r]);
+    first = false;
+  }
+  return text + ")";
+}
 
 /// Unrecoverable source failures (cannot open, unsupported format, device gone for good).
 class FrameSourceError : public std::runtime_error {
@@ -85,6 +131,13 @@ class FrameSource {
   virtual FrameSourceState state() const { return {}; }
   /// Frames skipped because they were bad (corrupt, truncated, failed to decode).
   virtual std::int64_t skippedFrames() const { return 0; }
+  /// The same frames by reason (total() == skippedFrames()). Same thread-safety as skippedFrames(). The
+  /// default, for a source that does not tell why: all of them under Other.
+  virtual SkippedFrames skippedByReason() const {
+    SkippedFrames skipped;
+    skipped[SkipReason::Other] = skippedFrames();
+    return skipped;
+  }
   /// True when frames come at the world's pace whatever the consumer does: a camera, or a file source
   /// played in real time (?rate=). False for files and the simulator read as fast as they are asked for.
   /// (What a full pipeline queue does by default: drop the oldest frame, or wait; QueueOverflow::Auto.)

@@ -29,6 +29,7 @@
 // finished() from any thread.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <future>
@@ -235,6 +236,7 @@ class Pipeline {
   // Copied by their owning thread so the publisher never calls into another thread's stage or source.
   std::atomic<std::int64_t> map_revision_{0};
   std::atomic<std::int64_t> source_skipped_{0};
+  std::array<std::atomic<std::int64_t>, kSkipReasonCount> source_skipped_by_reason_{};  ///< by SkipReason
   /// Clock times of the last frame that failed (skipped by the source or refused by the fingerprint
   /// stage) and of the last one fingerprinted: frames failing with none passing is no progress.
   std::atomic<double> last_frame_failed_s_{0.0};

@@ -262,6 +262,7 @@ struct PipelineStatus {
   /// queue included: full, its oldest step was finished first, Pipeline::kPlaceQueueCapacity).
   std::int64_t queue_kept_waits = 0;
   std::int64_t source_skipped = 0;   ///< bad frames the source skipped
+  SkippedFrames source_skipped_by_reason;          ///< the same, by reason (sums to source_skipped)
   SourceLink source_link = SourceLink::Streaming;  ///< the camera: streaming or reconnecting
   std::int64_t source_reconnects = 0;              ///< camera outages survived
   int source_reconnect_attempts = 0;               ///< failed attempts in the current outage

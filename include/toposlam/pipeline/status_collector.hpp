@@ -30,6 +30,7 @@ struct StatusCounters {
   double process_cpu_s = 0.0;
   std::int64_t frames_captured = 0;
   std::int64_t source_skipped = 0;
+  SkippedFrames source_skipped_by_reason;
   SourceLink source_link = SourceLink::Streaming;
   std::int64_t source_reconnects = 0;
   int source_reconnect_attempts = 0;

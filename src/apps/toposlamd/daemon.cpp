@@ -462,8 +462,9 @@ int runDaemon(const DaemonConfig& config) {
 
   const std::string error = pipeline.error();
   const PipelineStatus last = pipeline.status();
-  spdlog::info("toposlamd: {} frames published, {} dropped, {} places, {} map saves",
-               last.frames_published, last.frames_dropped, last.places, last.maps_saved);
+  const std::string skipped = skippedFramesText(last.source_skipped_by_reason);  // by reason, "" if none
+  spdlog::info("toposlamd: {} frames published, {} dropped, {} places, {} map saves{}", last.frames_published,
+               last.frames_dropped, last.places, last.maps_saved, skipped.empty() ? "" : ", " + skipped);
   if (const std::int64_t unsent = notifier.droppedNotifications(); unsent > 0)
     spdlog::warn("toposlamd: {} service notifications found systemd's notify socket full and were dropped", unsent);
   if (!error.empty()) {

@@ -20,8 +20,9 @@
 #include "toposlam_lcm/place_event_t.hpp"
 #include "toposlam_lcm/place_t.hpp"
 #include "toposlam_lcm/place_v1_t.hpp"
-#include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_t.hpp"
+#include "toposlam_lcm/status_v1_t.hpp"
+#include "toposlam_lcm/status_v2_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
 using namespace toposlam;
@@ -87,7 +88,8 @@ PipelineStatus fullStatus() {
   s.frames_published = 3'000'000'000;
   s.frames_dropped = 17;
   s.queue_kept_waits = 5;
-  s.source_skipped = 2;
+  s.source_skipped = 2 + 3 + 5 + 7 + 11 + 13 + 17;
+  s.source_skipped_by_reason.count = {2, 3, 5, 7, 11, 13, 17};  // unreadable, truncated, ... other
   s.source_link = SourceLink::Reconnecting;
   s.source_reconnects = 4;
   s.source_reconnect_attempts = 6;
@@ -222,7 +224,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(m.frames_published == 3'000'000'000);
     CHECK(m.frames_dropped == 17);
     CHECK(m.queue_kept_waits == 5);
-    CHECK(m.source_skipped == 2);
+    CHECK(m.source_skipped == 58);
     CHECK(m.source_state == "reconnecting");
     CHECK(m.source_reconnects == 4);
     CHECK(m.source_reconnect_attempts == 6);
@@ -239,6 +241,13 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(m.motion_standing_frames == 11);
     CHECK(m.motion_refused == 3);
     CHECK(m.motion_malformed == 4);
+    CHECK(m.source_skipped_unreadable == 2);
+    CHECK(m.source_skipped_truncated == 3);
+    CHECK(m.source_skipped_corrupt == 5);
+    CHECK(m.source_skipped_too_large == 7);
+    CHECK(m.source_skipped_wrong_format == 11);
+    CHECK(m.source_skipped_device_error == 13);
+    CHECK(m.source_skipped_other == 17);
     REQUIRE(m.num_stages == 2);
     CHECK(m.stages[0].name == "capture");
     CHECK(m.stages[0].latency_median_ms == 0.5f);
@@ -275,8 +284,16 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK_THAT(received[3].json, Catch::Contains("\"frames_captured\":3000000001"));
     CHECK_THAT(received[3].json, Catch::Contains("\"motion_refused\":3"));
     CHECK_THAT(received[3].json, Catch::Contains("\"motion_malformed\":4"));
+    CHECK_THAT(received[3].json,
+               Catch::Contains("\"source_skipped\":58,\"source_skipped_unreadable\":2,"
+                               "\"source_skipped_truncated\":3,\"source_skipped_corrupt\":5,"
+                               "\"source_skipped_too_large\":7,\"source_skipped_wrong_format\":11,"
+                               "\"source_skipped_device_error\":13,\"source_skipped_other\":17"));
     CHECK_THAT(received[3].summary,
-               Catch::EndsWith("  motion used, 11 standing frames skipped, motion refused 3, motion malformed 4"));
+               Catch::EndsWith(
+                   "  skipped 58 frames (unreadable 2, truncated 3, corrupt 5, too large 7, wrong format 11, "
+                   "device error 13, other 17)"
+                   "  motion used, 11 standing frames skipped, motion refused 3, motion malformed 4"));
   }
 }
 
@@ -324,6 +341,38 @@ TEST_CASE("GIVEN a status message recorded before motion_refused existed (status
   CHECK_THAT(out.json, Catch::Contains("\"motion_malformed\":0"));
   CHECK_THAT(out.json, Catch::Contains("\"processed\":99"));
   // Cut short, neither type reads it.
+  CHECK_FALSE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size() - 1, out));
+}
+
+TEST_CASE(
+    "GIVEN a status message recorded before source_skipped_<reason> existed (status_v2_t) WHEN decoded THEN "
+    "it reads with its motion counters and every skipped frame under other",
+    "[platform][lcm]") {
+  toposlam_lcm::status_v2_t old{};
+  old.state = "running";
+  old.frames_captured = 1234;
+  old.source_skipped = 6;
+  old.source_state = "streaming";
+  old.motion_state = "stale";
+  old.motion_standing_frames = 17;
+  old.motion_refused = 8;
+  old.motion_malformed = 9;
+  old.num_stages = 1;
+  old.stages.resize(1);
+  old.stages[0].name = "capture";
+  old.stages[0].processed = 99;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(old.getEncodedSize()));
+  REQUIRE(old.encode(bytes.data(), 0, static_cast<int>(bytes.size())) == static_cast<int>(bytes.size()));
+  ReceivedMessage out;
+  REQUIRE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size(), out));
+  CHECK_THAT(out.json, Catch::Contains("\"frames_captured\":1234"));
+  CHECK_THAT(out.json, Catch::Contains("\"source_skipped\":6,\"source_skipped_unreadable\":0"));
+  CHECK_THAT(out.json, Catch::Contains("\"source_skipped_other\":6"));
+  CHECK_THAT(out.json, Catch::Contains("\"motion_refused\":8"));
+  CHECK_THAT(out.json, Catch::Contains("\"motion_malformed\":9"));
+  CHECK_THAT(out.json, Catch::Contains("\"processed\":99"));
+  CHECK_THAT(out.summary, Catch::Contains("  skipped 6 frames (other 6)  motion stale"));
+  // Cut short, no type reads it.
   CHECK_FALSE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size() - 1, out));
 }
 

@@ -17,6 +17,8 @@
 #include "v4l2_frame_source.hpp"
 
 using toposlam::FrameSourceError;
+using toposlam::SkippedFrames;
+using toposlam::SkipReason;
 using toposlam::V4l2FrameSource;
 using toposlam::V4l2PixelFormat;
 using toposlam::V4l2SourceConfig;
@@ -207,6 +209,11 @@ SCENARIO("GIVEN error-flagged and short buffers WHEN capturing THEN they are ski
   CHECK(status.short_buffers == 1);
   CHECK(status.dropped == 0);           // skipped is not dropped
   CHECK(rig.state.queued.size() == 4);  // every buffer is back with the driver
+  // By reason, as the status message publishes them.
+  const SkippedFrames by_reason = rig.source->skippedByReason();
+  CHECK(by_reason[SkipReason::DeviceError] == 1);
+  CHECK(by_reason[SkipReason::Truncated] == 1);
+  CHECK(by_reason.total() == 2);
 }
 
 SCENARIO(
@@ -235,6 +242,10 @@ SCENARIO(
   CHECK(status.short_buffers == 1);
   CHECK(status.skipped == 2);
   CHECK(rig.state.queued.size() == 4);
+  const SkippedFrames by_reason = rig.source->skippedByReason();
+  CHECK(by_reason[SkipReason::Corrupt] == 1);    // the garbage
+  CHECK(by_reason[SkipReason::Truncated] == 1);  // the empty buffer
+  CHECK(by_reason.total() == 2);
 }
 
 SCENARIO(
