@@ -365,8 +365,9 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
     if (auto last = runner.finishTraversal()) mapPlace(*last);
     source_progress.finish();
     progress = nullptr;
-    if (source->skippedFrames() > 0)
-      std::cerr << "map: skipped " << source->skippedFrames() << " bad frames\n";
+    // By reason, as toposlamd's last log line: "map: skipped 3 frames (truncated 2, corrupt 1)".
+    if (const SkippedFrames skipped = source->skippedByReason(); skipped.total() > 0)
+      std::cerr << "map: " << skippedFramesText(skipped) << "\n";
     if (const FrameTimeline& timeline = segmentation_stage.sourceTimeline(); timeline.stepsBack() > 0)
       std::cerr << timelineSummary(timeline, "map") << "\n";
   }

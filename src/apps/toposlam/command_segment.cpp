@@ -142,7 +142,12 @@ void runSegment(const SegmentOptions& o) {
   std::printf("ms per frame: fingerprint median %.2f p99 %.2f; segment median %.3f p99 %.3f\n", f.median_ms,
               f.p99_ms, s.median_ms, s.p99_ms);
   if (source->skippedFrames() + refused > 0) {
-    std::printf("skipped frames: %lld\n", static_cast<long long>(source->skippedFrames() + refused));
+    // The source's by reason, as toposlamd's last log line, then the frames the extractor refused.
+    std::string line = "skipped frames: " + std::to_string(source->skippedFrames() + refused);
+    if (const std::string by_reason = skippedFramesText(source->skippedByReason()); !by_reason.empty())
+      line += " " + by_reason.substr(by_reason.find('('));  // "(truncated 2, corrupt 1)"
+    if (refused > 0) line += "; refused by the extractor " + std::to_string(refused);
+    std::printf("%s\n", line.c_str());
   }
   std::printf("wrote %s/{frames,places,dropped_places,timing}.csv and lambda2.svg\n", o.out.c_str());
 }
