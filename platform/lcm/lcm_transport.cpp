@@ -3,11 +3,13 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +19,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
+#include "lcm_fragment_monitor.hpp"
 #include "place_decode.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/io/image_codec.hpp"
@@ -27,6 +30,7 @@
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_v2_t.hpp"
+#include "toposlam_lcm/status_v3_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
 namespace toposlam {
@@ -63,14 +67,33 @@ std::unique_ptr<lcm::LCM> openLcm(const std::string& url) {
   return instance;
 }
 
-std::string lcmRouteProblem(const std::string& url) {
+std::string effectiveLcmUrl(const std::string& url) {
+  if (!url.empty()) return url;
+  const char* fallback = std::getenv("LCM_DEFAULT_URL");
+  return fallback != nullptr && *fallback != '\0' ? fallback : "udpm://239.255.76.67:7667";
+}
+
+std::optional<UdpmAddress> parseUdpmUrl(const std::string& url) {
   const std::string scheme = "udpm://";
-  if (url.rfind(scheme, 0) != 0) return "";
-  // udpm://GROUP:PORT?options; liblcm's defaults when left out.
-  std::string address = url.substr(scheme.size());
-  address = address.substr(0, address.find('?'));
-  std::string group = address.substr(0, address.find(':'));
-  if (group.empty()) group = "239.255.76.67";
+  if (url.rfind(scheme, 0) != 0) return std::nullopt;
+  UdpmAddress address;
+  const std::string rest = url.substr(scheme.size());
+  const std::size_t query = rest.find('?');
+  const std::string network = rest.substr(0, query);
+  const std::size_t colon = network.find(':');
+  if (!network.substr(0, colon).empty()) address.group = network.substr(0, colon);
+  if (colon != std::string::npos) address.port = std::atoi(network.c_str() + colon + 1);
+  // Options: key=value pairs separated by '&'; only the receive buffer's size matters to a listener.
+  std::istringstream options(query == std::string::npos ? "" : rest.substr(query + 1));
+  for (std::string option; std::getline(options, option, '&');)
+    if (option.rfind("recv_buf_size=", 0) == 0) address.recv_buf_size = std::atoi(option.c_str() + 14);
+  return address;
+}
+
+std::string lcmRouteProblem(const std::string& url) {
+  const std::optional<UdpmAddress> address = parseUdpmUrl(url);
+  if (!address) return "";
+  const std::string& group = address->group;
   sockaddr_in destination{};
   destination.sin_family = AF_INET;
   destination.sin_port = htons(7667);
@@ -226,6 +249,7 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.motion_standing_frames = motion_ ? motion_->standing_frames.load() : 0;
   msg.motion_refused = motion_ ? motion_->refused.load() : 0;
   msg.motion_malformed = motion_ ? motion_->malformed.load() : 0;
+  msg.motion_fragments_abandoned = motion_ ? motion_->fragments_abandoned.load() : 0;
   const SkippedFrames& skipped = s.source_skipped_by_reason;
   msg.source_skipped_unreadable = skipped[SkipReason::Unreadable];
   msg.source_skipped_truncated = skipped[SkipReason::Truncated];
@@ -347,9 +371,18 @@ const WireSchema kStatus = {fixed(8),
                             text(),
                             fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
                             text(),
-                            fixed(8 + 8 + 8 + 8 * 7),
+                            fixed(8 * 4 + 8 * 7),
                             length(),
                             array(kStageStatus)};
+const WireSchema kStatusV3 = {fixed(8),
+                              text(),
+                              fixed(4 + 4 + 8 * 5),
+                              text(),
+                              fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3),
+                              text(),
+                              fixed(8 + 8 + 8 + 8 * 7),
+                              length(),
+                              array(kStageStatus)};  // before motion_fragments_abandoned
 const WireSchema kStatusV2 = {
     fixed(8),         text(),   fixed(4 + 4 + 8 * 5), text(), fixed(8 + 4 + 8 + 4 * 4 + 4 + 8 * 3), text(),
     fixed(8 + 8 + 8), length(), array(kStageStatus)};  // before source_skipped_*
@@ -446,11 +479,24 @@ toposlam_lcm::status_t statusFromOld(const OldStatus& old) {
   return out;
 }
 
-/// A TOPOSLAM_STATUS message as status_t or, failing that, as status_v2_t (recorded before
-/// source_skipped_<reason> existed) or status_v1_t (before motion_refused and motion_malformed too; they then
-/// read 0).
+/// A TOPOSLAM_STATUS message as status_t or, failing that, as status_v3_t (recorded before
+/// motion_fragments_abandoned existed: it reads 0), status_v2_t (before source_skipped_<reason> too) or
+/// status_v1_t (before motion_refused and motion_malformed too; they then read 0).
 bool decodeStatusMessage(const void* data, std::size_t size, toposlam_lcm::status_t& out) {
   if (decodeMessage(data, size, out, "status")) return true;
+  if (toposlam_lcm::status_v3_t v3{}; decodeMessage(data, size, v3, "status_v3")) {
+    out = statusFromOld(v3);
+    out.motion_refused = v3.motion_refused;
+    out.motion_malformed = v3.motion_malformed;
+    out.source_skipped_unreadable = v3.source_skipped_unreadable;
+    out.source_skipped_truncated = v3.source_skipped_truncated;
+    out.source_skipped_corrupt = v3.source_skipped_corrupt;
+    out.source_skipped_too_large = v3.source_skipped_too_large;
+    out.source_skipped_wrong_format = v3.source_skipped_wrong_format;
+    out.source_skipped_device_error = v3.source_skipped_device_error;
+    out.source_skipped_other = v3.source_skipped_other;
+    return true;
+  }
   if (toposlam_lcm::status_v2_t v2{}; decodeMessage(data, size, v2, "status_v2")) {
     out = statusFromOld(v2);
     out.motion_refused = v2.motion_refused;
@@ -472,6 +518,7 @@ bool lcmArrayLengthsFit(const std::string& kind, const void* data, std::size_t s
                              : kind == "status"      ? &kStatus
                              : kind == "status_v1"   ? &kStatusV1
                              : kind == "status_v2"   ? &kStatusV2
+                             : kind == "status_v3"   ? &kStatusV3
                              : kind == "topology"    ? &kTopology
                              : kind == "motion"      ? &kMotion
                                                      : nullptr;
@@ -496,16 +543,46 @@ LcmSubscriber::LcmSubscriber(const std::string& url, const LcmChannels& known, c
     routes_.push_back(std::make_unique<Route>(Route{this, kind}));
     lcm_->subscribeFunction(channel, &LcmSubscriber::dispatch, routes_.back().get());
   }
+  openFragmentMonitor(url, channels);
 }
 
 LcmSubscriber::~LcmSubscriber() = default;
 
+void LcmSubscriber::openFragmentMonitor(const std::string& url, const std::vector<std::string>& channels) {
+  const std::optional<UdpmAddress> address = parseUdpmUrl(effectiveLcmUrl(url));
+  if (!address) return;  // memq://, file://, ...: no datagrams, nothing fragmented; the count stays 0
+  LcmFragmentTrackerConfig config;
+  config.channels = channels;
+  try {
+    monitor_ = std::make_unique<LcmFragmentMonitor>(*address, std::move(config));
+  } catch (const std::exception& e) {
+    fragments_abandoned_.store(-1);
+    spdlog::warn("lcm: fragmented messages abandoned on {} are not counted (reported as -1): {}", url, e.what());
+  }
+}
+
+LcmFragmentStats LcmSubscriber::fragmentStats() const { return monitor_ ? monitor_->stats() : LcmFragmentStats{}; }
+
 bool LcmSubscriber::handle(int timeout_ms) {
+  if (monitor_) return handleWithMonitor(timeout_ms);
   // lcm_handle_timeout waits in select(), which a signal interrupts with EINTR whatever SA_RESTART says
   // (signal(7)); that is the caller's cue to look at its stop flag, not an LCM failure.
   errno = 0;
   if (lcm_->handleTimeout(timeout_ms) >= 0) return true;
   return errno == EINTR;
+}
+
+// Waits on liblcm's descriptor and the fragment listener's together, so the listener is read as promptly as
+// liblcm's own receive thread reads its socket (a full socket buffer would lose datagrams to us alone).
+bool LcmSubscriber::handleWithMonitor(int timeout_ms) {
+  pollfd waiting[2] = {{lcm_->getFileno(), POLLIN, 0}, {monitor_->fd(), POLLIN, 0}};
+  const int ready = poll(waiting, 2, timeout_ms);
+  if (ready < 0) return errno == EINTR;  // a signal: the caller's cue to look at its flags
+  monitor_->drain(static_cast<double>(monotonicMicroseconds()) * 1e-6);
+  fragments_abandoned_.store(monitor_->stats().abandoned);
+  if ((waiting[0].revents & POLLIN) == 0) return (waiting[0].revents & (POLLERR | POLLNVAL)) == 0;
+  errno = 0;
+  return lcm_->handle() >= 0 || errno == EINTR;
 }
 
 void LcmSubscriber::dispatch(const lcm::ReceiveBuffer* buffer, const std::string& channel, Route* route) {
@@ -618,7 +695,7 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
     }
   } else if (kind == "status") {
     toposlam_lcm::status_t m{};
-    ok = decodeStatusMessage(data, size, m);  // older recordings: status_v2_t, status_v1_t
+    ok = decodeStatusMessage(data, size, m);  // older recordings: status_v3_t, status_v2_t, status_v1_t
     if (ok) {
       w.field("state", m.state);
       jsonNumber(w, "fps", m.fps);
@@ -645,7 +722,8 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
       w.field("places", m.places).field("map_revision", m.map_revision).field("maps_saved", m.maps_saved)
           .field("motion_messages", m.motion_messages).field("motion_state", m.motion_state)
           .field("motion_standing_frames", m.motion_standing_frames).field("motion_refused", m.motion_refused)
-          .field("motion_malformed", m.motion_malformed);
+          .field("motion_malformed", m.motion_malformed)
+          .field("motion_fragments_abandoned", m.motion_fragments_abandoned);
       w.key("stages").beginArray();
       for (const auto& st : m.stages) {
         w.beginObject().field("name", st.name);
@@ -670,7 +748,7 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
       if (const std::string skipped = skippedFramesText(skippedFramesOf(m)); !skipped.empty())
         out.summary += "  " + skipped;
       if (const std::string motion = motionStatusText(m.motion_state, m.motion_standing_frames, m.motion_refused,
-                                                          m.motion_malformed);
+                                                          m.motion_malformed, m.motion_fragments_abandoned);
           !motion.empty())
         out.summary += "  " + motion;
     }

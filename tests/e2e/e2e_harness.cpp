@@ -205,6 +205,8 @@ MotionStatusHistory motionStatusHistory(const std::vector<ReceivedMessage>& stat
       h.refused = std::max(h.refused, integerField(statuses[i], "motion_refused"));
     if (json.find("\"motion_malformed\"") != std::string::npos)
       h.malformed = std::max(h.malformed, integerField(statuses[i], "motion_malformed"));
+    if (json.find("\"motion_fragments_abandoned\"") != std::string::npos)
+      h.fragments_abandoned = std::max(h.fragments_abandoned, integerField(statuses[i], "motion_fragments_abandoned"));
   }
   if (!statuses.empty()) h.messages = integerField(statuses.back(), "motion_messages");
   return h;

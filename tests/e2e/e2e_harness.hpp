@@ -115,6 +115,7 @@ struct MotionStatusHistory {
   std::int64_t messages = -1;        ///< motion_messages of the last status, -1 without a status
   std::int64_t refused = 0;          ///< largest motion_refused
   std::int64_t malformed = 0;        ///< largest motion_malformed
+  std::int64_t fragments_abandoned = 0;  ///< largest motion_fragments_abandoned
 };
 MotionStatusHistory motionStatusHistory(const std::vector<ReceivedMessage>& statuses);
 

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "e2e_harness.hpp"
+#include "platform/lcm/lcm_fragment_sender.hpp"
 #include "toposlam/io/sim_source.hpp"
 #include "toposlam/io/source_uri.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
@@ -418,12 +419,14 @@ SCENARIO("Robot motion over LCM: the status says it is used while it arrives, an
 }
 
 SCENARIO("One motion message stamped with the wall clock among the robot's: refused and counted, the stop still seen; "
-         "two messages that are not motion_t counted as malformed") {
+         "two messages that are not motion_t counted as malformed, two fragmented ones left unfinished as "
+         "abandoned") {
   GIVEN("toposlamd on the simulated office at 25 fps and a robot node standing for 4 s, with one message in Unix time") {
     const fs::path dir = freshDirectory("motion-wall-clock");
     Heard heard;
     auto subscriber = subscribe(heard);
     auto robot = openLcm(kLcmUrl);
+    const test::MulticastSender fragment_sender(kLcmUrl);
     Daemon daemon({"--source", kRoute + "&rate=25", "--overflow", "block", "--map", (dir / "map.tsm").string(),
                    "--no-map-load", "--lcm-url", kLcmUrl},
                   "", dir / "toposlamd.log");
@@ -452,6 +455,13 @@ SCENARIO("One motion message stamped with the wall clock among the robot's: refu
           const std::string garbage = "not a motion_t";
           for (int i = 0; i < 2; ++i)
             robot->publish(LcmChannels{}.motion, garbage.data(), static_cast<unsigned int>(garbage.size()));
+          // ... and two fragmented messages from one node that lose fragments: the first superseded by the
+          // second, the second never finished (abandoned after 2 s of silence).
+          const std::vector<std::uint8_t> payload(3000, 0x5A);
+          const auto first = test::lcmFragments(LcmChannels{}.motion, payload, 1, 3);
+          const auto second = test::lcmFragments(LcmChannels{}.motion, payload, 2, 3);
+          for (const auto* datagram : {&first[0], &first[2], &second[0], &second[1]})
+            fragment_sender.send(*datagram);
         }
       }
       const bool lost = !heard.statuses.empty() &&
@@ -469,6 +479,7 @@ SCENARIO("One motion message stamped with the wall clock among the robot's: refu
       INFO("last status " << heard.statuses.back().json);
       CHECK(status.refused == 1);
       CHECK(status.malformed == 2);
+      CHECK(status.fragments_abandoned == 2);
       CHECK(status.first_used >= 0);
       CHECK(status.first_lost > status.first_used);
       // As in the scenario without the stray message: standing from 1 s after the first sample to 1 s after

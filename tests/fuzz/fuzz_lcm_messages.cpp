@@ -15,6 +15,7 @@
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_v2_t.hpp"
+#include "toposlam_lcm/status_v3_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
 namespace {
@@ -44,6 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case 1: decode<toposlam_lcm::place_event_t>("place_event", message, n); break;
     case 2:
       decode<toposlam_lcm::status_t>("status", message, n);
+      decode<toposlam_lcm::status_v3_t>("status_v3", message, n);
       decode<toposlam_lcm::status_v2_t>("status_v2", message, n);
       decode<toposlam_lcm::status_v1_t>("status_v1", message, n);
       break;

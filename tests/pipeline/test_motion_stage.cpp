@@ -140,8 +140,13 @@ TEST_CASE("GIVEN motion samples stamped by another clock WHEN frames arrive THEN
   CHECK(counters.use.load() == static_cast<int>(toposlam::MotionUse::Used));
   CHECK(stage.skippedFrames() == 10);  // 103.0 .. 103.9 s
   CHECK(toposlam::motionStatusText(counters) == "motion used, 10 standing frames skipped, motion refused 20");
-  CHECK(toposlam::motionStatusText("none", 0, 0, 0).empty());
-  CHECK(toposlam::motionStatusText("lost", 3, 0, 0) == "motion lost (segmenting by time), 3 standing frames skipped");
-  // Messages that could not be decoded are said even before any sample was used.
-  CHECK(toposlam::motionStatusText("none", 0, 0, 2) == "motion none, 0 standing frames skipped, motion malformed 2");
+  CHECK(toposlam::motionStatusText("none", 0, 0, 0, 0).empty());
+  CHECK(toposlam::motionStatusText("none", 0, 0, 0, -1).empty());  // fragments not counted: nothing to say
+  CHECK(toposlam::motionStatusText("lost", 3, 0, 0, 0) ==
+        "motion lost (segmenting by time), 3 standing frames skipped");
+  // Messages that could not be decoded, or were lost in reassembly, are said even before any sample was used.
+  CHECK(toposlam::motionStatusText("none", 0, 0, 2, 0) ==
+        "motion none, 0 standing frames skipped, motion malformed 2");
+  CHECK(toposlam::motionStatusText("none", 0, 0, 2, 3) ==
+        "motion none, 0 standing frames skipped, motion malformed 2, motion fragments abandoned 3");
 }

@@ -221,18 +221,20 @@ inline const char* toString(MotionUse use) {
   return use == MotionUse::Used ? "used" : use == MotionUse::Lost ? "lost" : use == MotionUse::Stale ? "stale" : "none";
 }
 
-/// The motion part of a status line, from the status message's motion_state, standing frames, refused samples
-/// and malformed messages: "motion used, 12 standing frames skipped", "motion stale (segmenting by time), 0
-/// standing frames skipped, motion refused 3, motion malformed 2"; "" while no motion arrived and nothing was
-/// refused or dropped.
+/// The motion part of a status line, from the status message's motion_state, standing frames, refused samples,
+/// malformed messages and abandoned fragmented messages: "motion used, 12 standing frames skipped", "motion
+/// stale (segmenting by time), 0 standing frames skipped, motion refused 3, motion malformed 2, motion
+/// fragments abandoned 1"; "" while no motion arrived and nothing was refused or dropped. A count of -1 (not
+/// counted) is left out.
 inline std::string motionStatusText(const std::string& state, std::int64_t standing_frames, std::int64_t refused,
-                                    std::int64_t malformed) {
-  if (state == toString(MotionUse::None) && refused == 0 && malformed == 0) return "";
+                                    std::int64_t malformed, std::int64_t fragments_abandoned) {
+  if (state == toString(MotionUse::None) && refused == 0 && malformed == 0 && fragments_abandoned <= 0) return "";
   std::string text = "motion " + state;
   if (state == toString(MotionUse::Lost) || state == toString(MotionUse::Stale)) text += " (segmenting by time)";
   text += ", " + std::to_string(standing_frames) + " standing frames skipped";
   if (refused > 0) text += ", motion refused " + std::to_string(refused);
   if (malformed > 0) text += ", motion malformed " + std::to_string(malformed);
+  if (fragments_abandoned > 0) text += ", motion fragments abandoned " + std::to_string(fragments_abandoned);
   return text;
 }
 
@@ -244,11 +246,13 @@ struct MotionStatusCounters {
   std::atomic<std::int64_t> standing_frames{0};  ///< frames left out of segmentation as standing
   std::atomic<std::int64_t> refused{0};          ///< samples the motion gate refused (MotionRefusals::total)
   std::atomic<std::int64_t> malformed{0};        ///< motion messages that could not be decoded (dropped)
+  /// fragmented motion messages the receiver abandoned (a fragment lost); -1: not counted
+  std::atomic<std::int64_t> fragments_abandoned{0};
 };
 /// motionStatusText of the counters as they are now.
 inline std::string motionStatusText(const MotionStatusCounters& counters) {
   return motionStatusText(toString(static_cast<MotionUse>(counters.use.load())), counters.standing_frames.load(),
-                          counters.refused.load(), counters.malformed.load());
+                          counters.refused.load(), counters.malformed.load(), counters.fragments_abandoned.load());
 }
 
 struct PipelineStatus {

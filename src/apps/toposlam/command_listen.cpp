@@ -221,6 +221,9 @@ void addListenCommand(CLI::App& app) {
     printRates(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (subscriber.malformed() > 0)
       std::cerr << "toposlam listen: " << subscriber.malformed() << " messages could not be decoded\n";
+    if (subscriber.fragments_abandoned() > 0)
+      std::cerr << "toposlam listen: " << subscriber.fragments_abandoned()
+                << " fragmented messages were abandoned unfinished (a fragment lost)\n";
     if (printed == 0 && options->timeout_s > 0 && g_interrupted == 0) {
       std::ostringstream message;
       message << "listen: no message within " << options->timeout_s << " s on " << url

@@ -402,6 +402,7 @@ int runDaemon(const DaemonConfig& config) {
     while (receiving.load()) {
       const bool open = motion.handle(200);
       motion_status.malformed.store(motion.malformed());  // dropped by the subscriber, counted in the status
+      motion_status.fragments_abandoned.store(motion.fragments_abandoned());  // lost in reassembly (-1: unknown)
       if (!open) break;
     }
   });

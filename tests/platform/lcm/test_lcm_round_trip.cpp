@@ -23,6 +23,7 @@
 #include "toposlam_lcm/status_t.hpp"
 #include "toposlam_lcm/status_v1_t.hpp"
 #include "toposlam_lcm/status_v2_t.hpp"
+#include "toposlam_lcm/status_v3_t.hpp"
 #include "toposlam_lcm/topology_t.hpp"
 
 using namespace toposlam;
@@ -136,6 +137,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
   motion.standing_frames.store(11);
   motion.refused.store(3);
   motion.malformed.store(4);
+  motion.fragments_abandoned.store(6);
   const std::int64_t before_us = monotonicMicroseconds();
   {
     LcmPipelineSink sink("file://" + path + "?mode=w", channels, 95, &motion);
@@ -241,6 +243,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(m.motion_standing_frames == 11);
     CHECK(m.motion_refused == 3);
     CHECK(m.motion_malformed == 4);
+    CHECK(m.motion_fragments_abandoned == 6);
     CHECK(m.source_skipped_unreadable == 2);
     CHECK(m.source_skipped_truncated == 3);
     CHECK(m.source_skipped_corrupt == 5);
@@ -283,7 +286,7 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
     CHECK(received[3].kind == "status");
     CHECK_THAT(received[3].json, Catch::Contains("\"frames_captured\":3000000001"));
     CHECK_THAT(received[3].json, Catch::Contains("\"motion_refused\":3"));
-    CHECK_THAT(received[3].json, Catch::Contains("\"motion_malformed\":4"));
+    CHECK_THAT(received[3].json, Catch::Contains("\"motion_malformed\":4,\"motion_fragments_abandoned\":6"));
     CHECK_THAT(received[3].json,
                Catch::Contains("\"source_skipped\":58,\"source_skipped_unreadable\":2,"
                                "\"source_skipped_truncated\":3,\"source_skipped_corrupt\":5,"
@@ -293,7 +296,8 @@ TEST_CASE("GIVEN a frame result with a finished place, a new topology and an est
                Catch::EndsWith(
                    "  skipped 58 frames (unreadable 2, truncated 3, corrupt 5, too large 7, wrong format 11, "
                    "device error 13, other 17)"
-                   "  motion used, 11 standing frames skipped, motion refused 3, motion malformed 4"));
+                   "  motion used, 11 standing frames skipped, motion refused 3, motion malformed 4, "
+                   "motion fragments abandoned 6"));
   }
 }
 
@@ -372,6 +376,42 @@ TEST_CASE(
   CHECK_THAT(out.json, Catch::Contains("\"motion_malformed\":9"));
   CHECK_THAT(out.json, Catch::Contains("\"processed\":99"));
   CHECK_THAT(out.summary, Catch::Contains("  skipped 6 frames (other 6)  motion stale"));
+  // Cut short, no type reads it.
+  CHECK_FALSE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size() - 1, out));
+}
+
+TEST_CASE(
+    "GIVEN a status message recorded before motion_fragments_abandoned existed (status_v3_t) WHEN decoded THEN "
+    "it reads with its skipped frames by reason and its motion counters, and no fragments abandoned",
+    "[platform][lcm]") {
+  toposlam_lcm::status_v3_t old{};
+  old.state = "running";
+  old.frames_captured = 1234;
+  old.source_skipped = 5;
+  old.source_skipped_truncated = 2;
+  old.source_skipped_corrupt = 3;
+  old.source_state = "streaming";
+  old.motion_state = "used";
+  old.motion_standing_frames = 17;
+  old.motion_refused = 8;
+  old.motion_malformed = 9;
+  old.num_stages = 1;
+  old.stages.resize(1);
+  old.stages[0].name = "capture";
+  old.stages[0].processed = 99;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(old.getEncodedSize()));
+  REQUIRE(old.encode(bytes.data(), 0, static_cast<int>(bytes.size())) == static_cast<int>(bytes.size()));
+  ReceivedMessage out;
+  REQUIRE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size(), out));
+  CHECK_THAT(out.json, Catch::Contains("\"frames_captured\":1234"));
+  CHECK_THAT(out.json, Catch::Contains("\"source_skipped\":5,\"source_skipped_unreadable\":0,"
+                                       "\"source_skipped_truncated\":2,\"source_skipped_corrupt\":3"));
+  CHECK_THAT(out.json, Catch::Contains("\"source_skipped_other\":0"));
+  CHECK_THAT(out.json, Catch::Contains("\"motion_refused\":8,\"motion_malformed\":9,"
+                                       "\"motion_fragments_abandoned\":0"));
+  CHECK_THAT(out.json, Catch::Contains("\"processed\":99"));
+  CHECK_THAT(out.summary, Catch::EndsWith("  skipped 5 frames (truncated 2, corrupt 3)  motion used, 17 standing "
+                                          "frames skipped, motion refused 8, motion malformed 9"));
   // Cut short, no type reads it.
   CHECK_FALSE(decodeLcmMessage("status", "TOPOSLAM_STATUS", bytes.data(), bytes.size() - 1, out));
 }

@@ -16,10 +16,12 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "toposlam/pipeline/stages.hpp"
+#include "toposlam/platform/lcm_fragment_tracker.hpp"
 
 namespace lcm {
 class LCM;
@@ -27,6 +29,8 @@ class ReceiveBuffer;
 }  // namespace lcm
 
 namespace toposlam {
+
+class LcmFragmentMonitor;
 
 struct LcmChannels {
   std::string place = "TOPOSLAM_PLACE";
@@ -38,6 +42,18 @@ struct LcmChannels {
 
 /// Opens an LCM instance; throws std::runtime_error with a hint (multicast route, URL syntax) on failure.
 std::unique_ptr<lcm::LCM> openLcm(const std::string& url);
+
+/// Where a udpm:// URL listens, as liblcm reads "udpm://GROUP:PORT?recv_buf_size=N&ttl=T" (a part left out:
+/// liblcm's default, group 239.255.76.67, port 7667, the kernel's buffer size).
+struct UdpmAddress {
+  std::string group = "239.255.76.67";
+  int port = 7667;
+  int recv_buf_size = 0;  ///< bytes; 0: the kernel's default
+};
+/// The URL liblcm opens for `url`: `url`, or for "" $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667.
+std::string effectiveLcmUrl(const std::string& url);
+/// The address of a udpm:// URL; nullopt for another provider (memq://, file://, ...).
+std::optional<UdpmAddress> parseUdpmUrl(const std::string& url);
 
 /// For a udpm:// URL: "" when the kernel has a route to its multicast group (what liblcm needs to open
 /// it), else why not, e.g. "no route to the multicast group 239.255.76.67: Network is unreachable". Asked
@@ -121,16 +137,29 @@ class LcmSubscriber {
   bool handle(int timeout_ms);
   std::int64_t received() const { return received_.load(); }
   std::int64_t malformed() const { return malformed_.load(); }
+  /// Fragmented messages on the subscribed channels (or whose channel never came: their first fragment was
+  /// lost) that liblcm began and abandoned before all their fragments came: superseded by the next message
+  /// of their sender, silent for LcmFragmentTrackerConfig::timeout_s, or their sender forgotten (more than
+  /// max_senders at once). Counted by a listener of our own beside liblcm (LcmFragmentTracker) on udpm://
+  /// URLs; 0 on other providers (memq://, file://: nothing is fragmented); -1 when that listener could not
+  /// be opened (a warning said why): not counted.
+  std::int64_t fragments_abandoned() const { return fragments_abandoned_.load(); }
+  /// Every count of that listener (all 0 without one). Read on the thread that calls handle().
+  LcmFragmentStats fragmentStats() const;
 
  private:
   struct Route;
   static void dispatch(const lcm::ReceiveBuffer* buffer, const std::string& channel, Route* route);
+  void openFragmentMonitor(const std::string& url, const std::vector<std::string>& channels);
+  bool handleWithMonitor(int timeout_ms);
 
   std::unique_ptr<lcm::LCM> lcm_;
   std::vector<std::unique_ptr<Route>> routes_;
   Callback callback_;
+  std::unique_ptr<LcmFragmentMonitor> monitor_;  ///< udpm:// only
   std::atomic<std::int64_t> received_{0};
   std::atomic<std::int64_t> malformed_{0};
+  std::atomic<std::int64_t> fragments_abandoned_{0};
 };
 
 }  // namespace toposlam
