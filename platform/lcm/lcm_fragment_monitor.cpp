@@ -42,7 +42,8 @@ LcmFragmentMonitor::LcmFragmentMonitor(const UdpmAddress& address, LcmFragmentTr
   local.sin_port = htons(static_cast<std::uint16_t>(address.port));
   ip_mreq membership{};
   membership.imr_interface.s_addr = htonl(INADDR_ANY);
-  if (inet_pton(AF_INET, address.group.c_str(), &membership.imr_multiaddr) != 1) {
+  // inet_aton, as liblcm reads the group: it takes the forms inet_pton refuses ("4026420291", "239.1").
+  if (inet_aton(address.group.c_str(), &membership.imr_multiaddr) == 0) {
     errno = EINVAL;
     fail(-1, "not a multicast group", address);
   }
