@@ -319,3 +319,10 @@ TEST_CASE("GIVEN a short video file WHEN played THEN its frames come out in orde
     CHECK(count == 5);
   }
 }
+
+SCENARIO("GIVEN the simulator and an image folder WHEN asked their state THEN they say what they are, not a camera") {
+  SimFrameSource sim(simConfigFromUri(parseSourceUri("sim:office?size=64x48")));
+  CHECK(sim.state().kind == SourceKind::Simulator);
+  ImageFilesSource images(std::string(TOPOSLAM_SAMPLES_DIR) + "/samples", 1.0);
+  CHECK(images.state().kind == SourceKind::ImageFiles);
+}
