@@ -37,7 +37,9 @@ std::string checkSourceUri(const std::string& uri) {
     checkFrameSourceUri(uri);  // the scheme, its keys and values, as the start judges them; nothing opened
     return "";
   } catch (const std::exception& e) {
-    return e.what();
+    // The factory says "source '<uri>': ..."; the caller names the key (source:) already.
+    const std::string problem = e.what();
+    return problem.rfind("source '", 0) == 0 ? problem.substr(7) : problem;
   }
 }
 
