@@ -20,6 +20,7 @@ named="$(grep -rhoE '(docs/|doc/toposlam/|\()[a-z0-9-]+\.md' "$tmp/root/etc" "$t
 for page in $(zcat "$tmp"/root/usr/share/man/man*/*.gz | grep -oE 'doc/toposlam/[a-z0-9-]+\.md' | sed 's|.*/||' | sort -u); do
   named="$named $page"
 done
+named="$(echo "$named" | tr ' ' '\n' | sed '/^$/d' | sort -u)"
 [ -n "$named" ] || fail "no page of docs/ is named anywhere: the search is broken"
 missing=""
 for page in $named; do [ -f "$doc/$page" ] || missing="$missing $page"; done
