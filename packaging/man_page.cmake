@@ -1,6 +1,8 @@
 # man_page.cmake: one gzipped man page from a program's --help, with help2man (cmake -P, at build time).
 #   -DHELP2MAN=... -DGZIP=... -DPROGRAM=path -DSECTION=1|8 -DNAME="what it is" -DVERSION=x.y.z -DOUT=name.N.gz
 #   [-DSUBCOMMANDS=ON]: also a COMMANDS section with each subcommand's --help (the CLI11 "Subcommands:" list).
+#   [-DINCLUDE=file.h2m]: help2man sections written by hand (EXIT STATUS, FILES, EXAMPLES: packaging/man/).
+# A subcommand's help becomes filled text (an option per .TP paragraph), so the page fits 80 columns.
 # gzip -9n: no name or time stamp in the archive, what lintian asks of a man page.
 cmake_minimum_required(VERSION 3.25)
 get_filename_component(_program_name "${PROGRAM}" NAME)
@@ -31,9 +33,20 @@ if(SUBCOMMANDS)
     string(REPLACE "${PROGRAM}" "${_program_name}" _sub "${_sub}")
     string(REPLACE "\\" "\\e" _sub "${_sub}")
     string(REGEX REPLACE "(^|\n)([.'])" "\\1\\\\&\\2" _sub "${_sub}")
-    string(APPEND _section ".SS ${_name}\n.nf\n${_sub}.fi\n")
+    # CLI11's columns as paragraphs: "  NAME  DESCRIPTION" (or DESCRIPTION on the next, indented line) is a
+    # .TP with NAME as its tag; a heading ("Usage:", "Options:") starts a paragraph of its own.
+    # (\\& before a description: a text line that starts with . or ' is no request.)
+    string(REGEX REPLACE "\n  ([^ \n][^\n]*)\n          +([^ \n][^\n]*)" "\n.TP\n\\1\n\\\\&\\2" _sub "\n${_sub}")
+    string(REGEX REPLACE "\n  ([^ \n.]+( [^ \n]+)*)  +([^\n]+)" "\n.TP\n\\1\n\\\\&\\3" _sub "${_sub}")
+    string(REGEX REPLACE "\n([A-Z][A-Za-z]*:)" "\n.PP\n\\1" _sub "${_sub}")
+    string(APPEND _section ".SS ${_name}\n${_sub}\n")
   endforeach()
   file(WRITE "${_include}" "${_section}")
+  set(_include_option --include "${_include}")
+endif()
+if(INCLUDE)
+  file(READ "${INCLUDE}" _sections)
+  file(APPEND "${_include}" "${_sections}")
   set(_include_option --include "${_include}")
 endif()
 

@@ -22,6 +22,7 @@ namespace {
 struct SchemeEntry {
   FrameSourceOpener opener;
   std::string usage;
+  FrameSourceChecker checker;  ///< may be empty: only the scheme is known to be right
 };
 
 // Holds the next frame until it is due; the wait is bounded (nextFor) and ends early on interrupt(). Due:
@@ -103,26 +104,44 @@ class RateLimitedSource : public FrameSource {
   bool interrupted_ = false;
 };
 
-std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
+/// An images: URI's settings, checked.
+struct ImagesParameters {
+  double hz = 1.0;
+  std::int64_t max_pixels = kDefaultMaxImagePixels;
+  bool hz_given = false;
+};
+
+ImagesParameters imagesParameters(const SourceUri& uri) {
   uri.requireOnly({"fps", "max_pixels"});
   if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': images: needs a folder, file or glob");
   // Frame timestamps (the segmentation window is in seconds): ?fps=HZ, else the real-time ?rate=HZ,
   // else 1 Hz (the bundled keyframes' rate), said in describe() so a user sees the assumption.
   // rate=recorded takes the times from timestamps.csv beside the frames.
   const bool recorded = playsAtRecordedRate(uri);
-  const bool given = uri.has("fps") || (uri.has("rate") && !recorded);
-  const double hz = uri.has("fps") ? uri.getDouble("fps", 1.0, 1e-3, 1e4)
-                    : recorded     ? 1.0
-                                   : uri.getDouble("rate", 1.0, 1e-3, 1e4);
-  return std::make_unique<ImageFilesSource>(uri.path, hz, uri.getInt("max_pixels", kDefaultMaxImagePixels, 1, 1LL << 32),
-                                            given);
+  ImagesParameters p;
+  p.hz_given = uri.has("fps") || (uri.has("rate") && !recorded);
+  p.hz = uri.has("fps") ? uri.getDouble("fps", 1.0, 1e-3, 1e4)
+         : recorded     ? 1.0
+                        : uri.getDouble("rate", 1.0, 1e-3, 1e4);
+  p.max_pixels = uri.getInt("max_pixels", kDefaultMaxImagePixels, 1, 1LL << 32);
+  return p;
+}
+
+std::unique_ptr<FrameSource> openImages(const SourceUri& uri) {
+  const ImagesParameters p = imagesParameters(uri);
+  return std::make_unique<ImageFilesSource>(uri.path, p.hz, p.max_pixels, p.hz_given);
+}
+
+/// A video: URI's rate (0: as fast as asked, or the recorded rate), checked.
+double videoRate(const SourceUri& uri) {
+  uri.requireOnly({});
+  if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': video: needs a file");
+  return playsAtRecordedRate(uri) ? 0.0 : uri.getDouble("rate", 0.0, 1e-3, 1e4);
 }
 
 // video: lives in a module loaded on first use (source_modules.hpp; platform/video).
 std::unique_ptr<FrameSource> openVideo(const SourceUri& uri) {
-  uri.requireOnly({});
-  if (uri.path.empty()) throw FrameSourceError("source '" + uri.text + "': video: needs a file");
-  const double rate = playsAtRecordedRate(uri) ? 0.0 : uri.getDouble("rate", 0.0, 1e-3, 1e4);
+  const double rate = videoRate(uri);
   using Open = FrameSource* (*)(const char*, double, std::string*);
   const auto open = reinterpret_cast<Open>(sourceModuleSymbol("video", "toposlam_source_video_open_v2"));
   std::string error;
@@ -147,12 +166,14 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, SchemeEntry> schemes;
   Registry() {
-    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ&rate=HZ|recorded&max_pixels=N]"};
-    schemes["video"] = {openVideo, "video:FILE[?rate=HZ|recorded]"};
-    schemes["libcamera"] = {openLibcamera, "libcamera:ID?size=WxH&buffers=N (empty ID: the first camera)"};
+    schemes["images"] = {openImages, "images:FOLDER_OR_GLOB[?fps=HZ&rate=HZ|recorded&max_pixels=N]",
+                         [](const SourceUri& uri) { (void)imagesParameters(uri); }};
+    schemes["video"] = {openVideo, "video:FILE[?rate=HZ|recorded]", [](const SourceUri& uri) { (void)videoRate(uri); }};
+    schemes["libcamera"] = {openLibcamera, "libcamera:ID?size=WxH&buffers=N (empty ID: the first camera)", {}};
     schemes["sim"] = {openSim,
                       "sim:WORLD?route=R&fps=F&size=WxH&seed=S[&speed=&fov=&light=day|night|warm|cool&noise=&people=&"
-                      "pitch=&moved=0|1&rate=HZ]"};
+                      "pitch=&moved=0|1&rate=HZ]",
+                      [](const SourceUri& uri) { (void)simConfigFromUri(uri); }};
   }
 };
 
@@ -169,14 +190,15 @@ std::string schemeList() {
 
 }  // namespace
 
-void registerFrameSourceScheme(const std::string& scheme, FrameSourceOpener opener, const std::string& usage) {
+void registerFrameSourceScheme(const std::string& scheme, FrameSourceOpener opener, const std::string& usage,
+                               FrameSourceChecker checker) {
   const bool valid = !scheme.empty() && std::all_of(scheme.begin(), scheme.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
   });
   if (!valid || !opener) throw FrameSourceError("registerFrameSourceScheme: bad scheme '" + scheme + "' or no opener");
   Registry& entries = registry();
   const std::lock_guard lock(entries.mutex);
-  entries.schemes[scheme] = {std::move(opener), usage};
+  entries.schemes[scheme] = {std::move(opener), usage, std::move(checker)};
 }
 
 std::vector<std::pair<std::string, std::string>> registeredFrameSourceSchemes() {
@@ -217,6 +239,23 @@ std::unique_ptr<FrameSource> openFrameSource(const std::string& text) {
   if (recorded) source = makeRecordedRateSource(std::move(source));
   if (rate > 0) source = makeRateLimitedSource(std::move(source), rate);
   return source;
+}
+
+void checkFrameSourceUri(const std::string& text) {
+  const SourceUri uri = parseSourceUri(text);
+  if (uri.scheme.empty()) return;
+  FrameSourceChecker checker;
+  bool known = false;
+  {
+    Registry& entries = registry();
+    const std::lock_guard lock(entries.mutex);
+    const auto found = entries.schemes.find(uri.scheme);
+    known = found != entries.schemes.end();
+    if (known) checker = found->second.checker;
+  }
+  if (!known) throw FrameSourceError("source '" + text + "': unknown scheme '" + uri.scheme + ":'; use one of:" + schemeList());
+  if (!playsAtRecordedRate(uri)) (void)uri.getDouble("rate", 0.0, 1e-3, 1e4);
+  if (checker) checker(uri);
 }
 
 bool playsAtRecordedRate(const SourceUri& uri) { return uri.getString("rate", "") == "recorded"; }

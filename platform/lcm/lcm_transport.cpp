@@ -222,6 +222,19 @@ void LcmPipelineSink::publish(const FrameResult& r) {
   }
 }
 
+namespace {
+
+/// The STATUS line's source part: "camera streaming (0 reconnects, 0 lost by the driver)" for a camera,
+/// "simulator running", "reading images", "reading a video file" for the others (sourceStateName).
+std::string sourceStateText(const toposlam_lcm::status_t& m) {
+  for (const SourceKind kind : {SourceKind::Simulator, SourceKind::ImageFiles, SourceKind::VideoFile})
+    if (m.source_state == sourceStateName(kind, SourceLink::Streaming)) return sourceActivityText(kind, SourceLink::Streaming);
+  return "camera " + m.source_state + " (" + std::to_string(m.source_reconnects) + " reconnects, " +
+         std::to_string(m.source_dropped) + " lost by the driver)";
+}
+
+}  // namespace
+
 void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   toposlam_lcm::status_t msg{};
   msg.utime = monotonicMicroseconds();
@@ -233,7 +246,7 @@ void LcmPipelineSink::publishStatus(const PipelineStatus& s) {
   msg.frames_dropped = s.frames_dropped;
   msg.queue_kept_waits = s.queue_kept_waits;
   msg.source_skipped = s.source_skipped;
-  msg.source_state = toString(s.source_link);
+  msg.source_state = sourceStateName(s.source_kind, s.source_link);
   msg.source_reconnects = s.source_reconnects;
   msg.source_reconnect_attempts = s.source_reconnect_attempts;
   msg.source_dropped = s.source_dropped;
@@ -737,14 +750,12 @@ bool decodeLcmMessage(const std::string& kind, const std::string& channel, const
       char line[320];
       std::snprintf(line, sizeof line,
                     "STATUS %s  %.1f fps  latency median %.1f / p99 %.1f ms  %lld published  %lld dropped  "
-                    "%lld kept waits  cpu %.0f%%  camera %s (%lld reconnects, %lld lost by the driver)",
+                    "%lld kept waits  cpu %.0f%%  ",
                     m.state.c_str(), static_cast<double>(m.fps), static_cast<double>(m.latency_median_ms),
                     static_cast<double>(m.latency_p99_ms), static_cast<long long>(m.frames_published),
                     static_cast<long long>(m.frames_dropped), static_cast<long long>(m.queue_kept_waits),
-                    static_cast<double>(m.cpu_percent),
-                    m.source_state.c_str(), static_cast<long long>(m.source_reconnects),
-                    static_cast<long long>(m.source_dropped));
-      out.summary = line;
+                    static_cast<double>(m.cpu_percent));
+      out.summary = line + sourceStateText(m);
       if (const std::string skipped = skippedFramesText(skippedFramesOf(m)); !skipped.empty())
         out.summary += "  " + skipped;
       if (const std::string motion = motionStatusText(m.motion_state, m.motion_standing_frames, m.motion_refused,

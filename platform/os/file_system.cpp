@@ -7,6 +7,11 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <system_error>
+#include <vector>
 
 namespace toposlam {
 
@@ -57,6 +62,22 @@ std::uint64_t fileSizeLimitBytes() {
   rlimit limit{};
   if (::getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 0;
   return static_cast<std::uint64_t>(limit.rlim_cur);
+}
+
+TemporaryFolder::TemporaryFolder(const std::string& prefix) {
+  const char* base = std::getenv("TMPDIR");
+  const std::filesystem::path folder = base != nullptr && *base != '\0' ? base : "/tmp";
+  const std::string pattern = (folder / (prefix + "XXXXXX")).string();
+  std::vector<char> name(pattern.begin(), pattern.end());
+  name.push_back('\0');
+  if (::mkdtemp(name.data()) == nullptr)
+    throw std::runtime_error("cannot create a temporary folder in " + folder.string() + ": " + std::strerror(errno));
+  path_ = name.data();
+}
+
+TemporaryFolder::~TemporaryFolder() {
+  std::error_code ignored;  // a folder someone else emptied or removed is gone all the same
+  std::filesystem::remove_all(path_, ignored);
 }
 
 }  // namespace toposlam

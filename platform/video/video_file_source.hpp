@@ -31,6 +31,7 @@ class VideoFileSource : public FrameSource {
     return skipped;
   }
   std::int64_t frameCountHint() const override { return frame_count_; }
+  FrameSourceState state() const override { return FrameSourceState::of(SourceKind::VideoFile); }
 
  private:
   std::string path_;

@@ -86,7 +86,9 @@ std::string WatchdogConfig::validate() const {
 
 std::string statusLine(const PipelineStatus& s) {
   char camera[128];
-  if (s.source_link == SourceLink::Reconnecting)
+  if (s.source_kind != SourceKind::Camera)
+    std::snprintf(camera, sizeof camera, "%s", sourceActivityText(s.source_kind, s.source_link));
+  else if (s.source_link == SourceLink::Reconnecting)
     std::snprintf(camera, sizeof camera, "camera reconnecting (attempt %d, %lld reconnects, %lld lost by the driver)",
                   s.source_reconnect_attempts + 1, static_cast<long long>(s.source_reconnects),
                   static_cast<long long>(s.source_dropped));
@@ -258,6 +260,7 @@ bool Pipeline::forward(Q& queue, T&& item) {
 
 void Pipeline::captureLoop() {
   try {
+    source_kind_.store(source_.state().kind);
     while (!stop_requested_.load()) {
       Frame frame;
       // Bounded wait: a silent or reconnecting camera still lets this thread beat and see a stop.
@@ -269,6 +272,7 @@ void Pipeline::captureLoop() {
         for (std::size_t r = 0; r < kSkipReasonCount; ++r)
           source_skipped_by_reason_[r].store(by_reason.count[r]);
       }
+      source_kind_.store(state.kind);
       source_reconnecting_.store(state.link == SourceLink::Reconnecting);
       source_reconnects_.store(state.reconnects);
       source_reconnect_attempts_.store(state.reconnect_attempts);
@@ -570,6 +574,7 @@ StatusCounters Pipeline::statusCounters(std::int64_t published) const {
   c.source_skipped = source_skipped_.load();
   for (std::size_t r = 0; r < kSkipReasonCount; ++r)
     c.source_skipped_by_reason.count[r] = source_skipped_by_reason_[r].load();
+  c.source_kind = source_kind_.load();
   c.source_link = source_reconnecting_.load() ? SourceLink::Reconnecting : SourceLink::Streaming;
   c.source_reconnects = source_reconnects_.load();
   c.source_reconnect_attempts = source_reconnect_attempts_.load();

@@ -58,6 +58,7 @@ PipelineStatus StatusCollector::collect(double now_s, const std::string& state, 
   s.frames_published = published_;
   s.source_skipped = counters.source_skipped;
   s.source_skipped_by_reason = counters.source_skipped_by_reason;
+  s.source_kind = counters.source_kind;
   s.source_link = counters.source_link;
   s.source_reconnects = counters.source_reconnects;
   s.source_reconnect_attempts = counters.source_reconnect_attempts;

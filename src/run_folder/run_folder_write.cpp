@@ -94,15 +94,15 @@ std::vector<PlaceRecord> placeRows(const std::vector<SegmentedPlace>& places,
 
 void writeFrames(const fs::path& dir, const std::vector<FrameRecord>& rows, FrameColumns columns) {
   const bool loop = columns == FrameColumns::WithLoopClosures;
+  const bool probability = loop || columns == FrameColumns::WithNodeProbability;
   OutputFile out(dir / run_files::kFrames);
-  out << "frame,time,name,lambda2,place,node" << (loop ? ",node_probability,match,match_score" : "") << "\n";
+  out << "frame,time,name,lambda2,place,node" << (probability ? ",node_probability" : "")
+      << (loop ? ",match,match_score" : "") << "\n";
   for (const FrameRecord& row : rows) {
     out << row.frame << ',' << formatNumber(row.time_s, 6) << ',' << csvField(row.name) << ','
         << optionalNumber(row.lambda2) << ',' << row.place << ',' << row.node;
-    if (loop) {
-      out << ',' << optionalNumber(row.node_probability) << ',' << row.match << ','
-          << (row.match >= 0 ? formatNumber(row.match_score, 6) : std::string());
-    }
+    if (probability) out << ',' << optionalNumber(row.node_probability);
+    if (loop) out << ',' << row.match << ',' << (row.match >= 0 ? formatNumber(row.match_score, 6) : std::string());
     out << '\n';
   }
   out.commit();

@@ -677,6 +677,22 @@ SCENARIO("The status line names the camera state") {
   CHECK_THAT(statusLine(s), Catch::EndsWith("camera reconnecting (attempt 1, 1 reconnects, 0 lost by the driver)"));
 }
 
+SCENARIO("GIVEN a source that is no camera WHEN the status is formatted THEN it says what the source is") {
+  PipelineStatus s;
+  s.state = "running";
+  s.fps = 10.0;
+  s.source_kind = SourceKind::Simulator;
+  CHECK(statusLine(s) == "running: 10.0 fps, latency p99 0.0 ms, 0 places, map rev 0, 0 dropped, 0 kept waits; "
+                         "simulator running");
+  s.source_kind = SourceKind::ImageFiles;
+  CHECK_THAT(statusLine(s), Catch::EndsWith("; reading images"));
+  s.source_kind = SourceKind::VideoFile;
+  CHECK_THAT(statusLine(s), Catch::EndsWith("; reading a video file"));
+  CHECK(std::string(sourceStateName(SourceKind::Simulator, SourceLink::Streaming)) == "simulator");
+  CHECK(std::string(sourceStateName(SourceKind::Camera, SourceLink::Reconnecting)) == "reconnecting");
+}
+
+
 SCENARIO(
     "GIVEN a source that skips 10 frames, 5 corrupt and 5 truncated WHEN the pipeline runs THEN the status "
     "counts them by reason and the status line says so") {

@@ -278,6 +278,21 @@ SCENARIO("GIVEN a run folder made by the writers WHEN it is read back THEN every
   }
 }
 
+SCENARIO("GIVEN frames with node probabilities and no frame matches (a map's export) WHEN written and read THEN the "
+         "probabilities come back and the folder has no match columns", "[run_folder]") {
+  const auto dir = scratchDir("node-probability-columns");
+  FrameRecord row;
+  row.place = 0;
+  row.node = 2;
+  row.node_probability = 0.625;
+  writeFrames(dir, {row}, FrameColumns::WithNodeProbability);
+  CHECK(readText(dir / run_files::kFrames) == "frame,time,name,lambda2,place,node,node_probability\n0,0.000000,,,0,2,0.625000\n");
+  const RunData run = loadRun(dir.string());
+  REQUIRE(run.frames.size() == 1);
+  CHECK(run.frames[0].node_probability == 0.625);
+  CHECK_FALSE(run.has_frame_matches);
+}
+
 SCENARIO("GIVEN the segmentation columns and the simulator's labels WHEN written THEN the headers are exact and read back",
          "[run_folder]") {
   const auto dir = scratchDir("segmentation-columns");

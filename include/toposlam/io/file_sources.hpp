@@ -41,6 +41,7 @@ class ImageFilesSource : public FrameSource {
   /// Unreadable, truncated, corrupt or over the caps (ImageReadError::Kind).
   SkippedFrames skippedByReason() const override { return skipped_; }
   std::int64_t frameCountHint() const override { return static_cast<std::int64_t>(files_.size()); }
+  FrameSourceState state() const override { return FrameSourceState::of(SourceKind::ImageFiles); }
   /// The file name (without its folder) of file `sequence`; "" out of range.
   std::string frameName(std::int64_t sequence) const override;
   /// The file `last_sequence` when it has that name, else the first file of that name (files were added or

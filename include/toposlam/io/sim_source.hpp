@@ -27,6 +27,7 @@ class SimFrameSource : public FrameSource {
   std::optional<Frame> next() override;
   void interrupt() override { interrupted_.store(true); }
   std::int64_t frameCountHint() const override { return simulator_->frameCount(); }
+  FrameSourceState state() const override { return FrameSourceState::of(SourceKind::Simulator); }
   const sim::Simulator& simulator() const { return *simulator_; }
   /// Ground truth of the frame last returned by next() (default values before the first).
   const sim::GroundTruth& lastTruth() const { return last_truth_; }

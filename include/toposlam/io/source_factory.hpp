@@ -24,11 +24,23 @@ namespace toposlam {
 /// Builds a source from a parsed URI; throws FrameSourceError with an actionable message.
 using FrameSourceOpener = std::function<std::unique_ptr<FrameSource>(const SourceUri&)>;
 
+/// Checks a parsed URI's options as its opener would, opening nothing (no device, no file); throws
+/// FrameSourceError with the opener's message for a bad key or value.
+using FrameSourceChecker = std::function<void(const SourceUri&)>;
+
 /// Adds or replaces a scheme (lower case letters, digits, '_' or '-'). `usage` is shown in errors,
-/// e.g. "v4l2:/dev/videoN?size=WxH&fps=F&format=F".
-void registerFrameSourceScheme(const std::string& scheme, FrameSourceOpener opener, const std::string& usage);
+/// e.g. "v4l2:/dev/videoN?size=WxH&fps=F&format=F". `checker` (optional) lets checkFrameSourceUri judge the
+/// options without opening.
+void registerFrameSourceScheme(const std::string& scheme, FrameSourceOpener opener, const std::string& usage,
+                               FrameSourceChecker checker = {});
 /// Registered schemes with their usage strings, sorted by scheme.
 std::vector<std::pair<std::string, std::string>> registeredFrameSourceSchemes();
+
+/// What openFrameSource would refuse about `uri` before opening anything: its syntax, an unknown scheme, the
+/// scheme's keys and values (through its checker, when it has one) and the common `rate`. Throws
+/// FrameSourceError with the same message as openFrameSource; opens no device and reads no file. A plain path
+/// (no scheme) is left to the caller.
+void checkFrameSourceUri(const std::string& uri);
 
 /// Opens a source; throws FrameSourceError naming the unknown scheme, bad key or bad value.
 std::unique_ptr<FrameSource> openFrameSource(const std::string& uri);

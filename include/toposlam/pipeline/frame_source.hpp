@@ -98,12 +98,55 @@ inline const char* toString(SourceLink link) {
   return link == SourceLink::Reconnecting ? "reconnecting" : "streaming";
 }
 
+/// What a source reads from: the status says "camera streaming" only for a camera.
+enum class SourceKind { Camera, Simulator, ImageFiles, VideoFile };
+
+/// What the status says a source is doing: "camera streaming", "camera reconnecting", "simulator running",
+/// "reading images", "reading a video file".
+inline const char* sourceActivityText(SourceKind kind, SourceLink link) {
+  switch (kind) {
+    case SourceKind::Simulator:
+      return "simulator running";
+    case SourceKind::ImageFiles:
+      return "reading images";
+    case SourceKind::VideoFile:
+      return "reading a video file";
+    case SourceKind::Camera:
+      break;
+  }
+  return link == SourceLink::Reconnecting ? "camera reconnecting" : "camera streaming";
+}
+
+/// The status message's source_state (status_t.lcm): a camera's link ("streaming", "reconnecting"), else
+/// what the source is ("simulator", "images", "video").
+inline const char* sourceStateName(SourceKind kind, SourceLink link) {
+  switch (kind) {
+    case SourceKind::Simulator:
+      return "simulator";
+    case SourceKind::ImageFiles:
+      return "images";
+    case SourceKind::VideoFile:
+      return "video";
+    case SourceKind::Camera:
+      break;
+  }
+  return toString(link);
+}
+
 /// A snapshot of what a source is doing (no strings: read on the frame path).
 struct FrameSourceState {
+  SourceKind kind = SourceKind::Camera;  ///< sources other than cameras say what they are
   SourceLink link = SourceLink::Streaming;
   std::int64_t reconnects = 0;   ///< outages survived (successful reopenings)
   int reconnect_attempts = 0;    ///< failed attempts in the current outage
   std::int64_t dropped = 0;      ///< frames lost according to the driver's sequence gaps
+
+  /// The state of a source that is no camera: always delivering, nothing to reconnect.
+  static FrameSourceState of(SourceKind kind) {
+    FrameSourceState state;
+    state.kind = kind;
+    return state;
+  }
 };
 
 class FrameSource {

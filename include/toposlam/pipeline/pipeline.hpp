@@ -245,6 +245,7 @@ class Pipeline {
   /// frames pass, none arrive, or not yet heartbeat_timeout_s.
   double failingWithoutProgressFor(double now) const;
   std::atomic<bool> source_reconnecting_{false};
+  std::atomic<SourceKind> source_kind_{SourceKind::Camera};
   std::atomic<std::int64_t> source_reconnects_{0};
   std::atomic<int> source_reconnect_attempts_{0};
   std::atomic<std::int64_t> source_dropped_{0};

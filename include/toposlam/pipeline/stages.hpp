@@ -267,6 +267,7 @@ struct PipelineStatus {
   std::int64_t queue_kept_waits = 0;
   std::int64_t source_skipped = 0;   ///< bad frames the source skipped
   SkippedFrames source_skipped_by_reason;          ///< the same, by reason (sums to source_skipped)
+  SourceKind source_kind = SourceKind::Camera;      ///< what the frames come from (the status names it)
   SourceLink source_link = SourceLink::Streaming;  ///< the camera: streaming or reconnecting
   std::int64_t source_reconnects = 0;              ///< camera outages survived
   int source_reconnect_attempts = 0;               ///< failed attempts in the current outage

@@ -31,6 +31,7 @@ struct StatusCounters {
   std::int64_t frames_captured = 0;
   std::int64_t source_skipped = 0;
   SkippedFrames source_skipped_by_reason;
+  SourceKind source_kind = SourceKind::Camera;
   SourceLink source_link = SourceLink::Streaming;
   std::int64_t source_reconnects = 0;
   int source_reconnect_attempts = 0;

@@ -75,9 +75,10 @@ struct FrameRecord {
   double match_score = 0.0;  ///< written only with a match
 };
 
-/// frames.csv's columns: `frame,time,name,lambda2,place,node` (segment, the LCM-log converter), or those
-/// and `node_probability,match,match_score` (map).
-enum class FrameColumns { Segmentation, WithLoopClosures };
+/// frames.csv's columns: `frame,time,name,lambda2,place,node` (segment, the LCM-log converter), those and
+/// `node_probability` (a map file's export: no frame-level matches), or those and
+/// `node_probability,match,match_score` (map).
+enum class FrameColumns { Segmentation, WithNodeProbability, WithLoopClosures };
 
 /// One row of places.csv / dropped_places.csv.
 struct PlaceRecord {

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include <spdlog/spdlog.h>
 
@@ -32,12 +33,45 @@ int checkStandardOutput(int status, const std::string& program) {
   return status == 0 ? 1 : status;
 }
 
+/// The first word of the command line that is neither an option nor --log-level's value: the command asked
+/// for; empty when there is none.
+std::string commandWord(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--log-level") {
+      ++i;
+    } else if (!word.empty() && word[0] != '-') {
+      return word;
+    }
+  }
+  return "";
+}
+
+/// "unknown command 'X'; the commands are: ..." when the command line's command is none of `app`'s (CLI11
+/// alone says "A subcommand is required"); empty otherwise.
+std::string unknownCommand(CLI::App& app, int argc, char** argv) {
+  const std::string word = commandWord(argc, argv);
+  if (word.empty() || !app.get_subcommands().empty()) return "";
+  std::string names;
+  bool known = false;
+  for (const CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) {
+    known = known || command->check_name(word);
+    if (!command->get_group().empty()) names += (names.empty() ? "" : ", ") + command->get_name();
+  }
+  if (known) return "";
+  return "unknown command '" + word + "'; the commands are: " + names + " (--help says what each does)";
+}
+
 int parse(CLI::App& app, int argc, char** argv, const std::string& program) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
     return e.get_exit_code();  // a command's own status, already explained on stderr
   } catch (const CLI::ParseError& e) {
+    if (const std::string unknown = unknownCommand(app, argc, argv); !unknown.empty() && e.get_exit_code() != 0) {
+      std::cerr << program << ": error: " << unknown << "\n";
+      return 2;
+    }
     const int code = app.exit(e);  // prints the help, the version or the usage error
     return code == 0 ? 0 : 2;
   } catch (const ConfigError& e) {

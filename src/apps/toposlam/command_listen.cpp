@@ -76,6 +76,19 @@ std::string resolveChannel(const std::string& item, const LcmChannels& known) {
   return item;
 }
 
+/// Why a --channels item names no channel: the keys and names it could have been, where those names come
+/// from (the config file read, or the built-in defaults when there is none), and a near miss.
+std::string unknownChannelText(const std::string& item, const LcmChannels& known, const std::string& names_from) {
+  std::string text = "unknown channel '" + item + "'";
+  for (const char* key : {"place", "place_event", "topology", "status", "motion"}) {
+    if (item.size() > 1 && (item == std::string(key) + "s" || item + "s" == key))
+      text += " (did you mean '" + std::string(key) + "'?)";
+  }
+  return text + "; give a key (place, place_event, topology, status, motion) or a channel name (" + known.place +
+         ", " + known.place_event + ", " + known.topology + ", " + known.status + ", " + known.motion + "; " +
+         names_from + ")";
+}
+
 /// CLOCK_MONOTONIC (steady_clock on Linux), seconds: the clock of motion_t.utime on this host.
 double monotonicSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -124,7 +137,10 @@ void addListenCommand(CLI::App& app) {
   cmd->callback([options] {
     DaemonConfig config;
     const std::string config_path = options->config.empty() ? defaultDaemonConfigPath() : options->config;
-    if (!options->config.empty() || std::filesystem::exists(config_path)) config = loadDaemonConfig(config_path);
+    const bool read_config = !options->config.empty() || std::filesystem::exists(config_path);
+    if (read_config) config = loadDaemonConfig(config_path);
+    const std::string names_from = read_config ? "names from " + config_path
+                                               : "the built-in names: there is no config at " + config_path;
     const LcmChannels known = channelsOf(config.lcm);
     const std::string url = options->url.empty() ? config.lcm.url : options->url;
 
@@ -134,9 +150,7 @@ void addListenCommand(CLI::App& app) {
     if (channels.empty()) throw CLI::ValidationError("--channels", "give at least one channel");
     for (const std::string& c : channels)
       if (c != known.place && c != known.place_event && c != known.topology && c != known.status && c != known.motion)
-        throw CLI::ValidationError("--channels", "unknown channel '" + c + "': the config (" + config_path +
-                                                     ") names " + known.place + ", " + known.place_event + ", " +
-                                                     known.topology + ", " + known.status + ", " + known.motion);
+        throw CLI::ValidationError("--channels", unknownChannelText(c, known, names_from));
 
     long long printed = 0;
     std::map<std::string, long long> per_channel;

@@ -47,6 +47,7 @@
 #include "toposlam/topology/map_store.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
+#include "map_application_data.hpp"
 #include "motion_input.hpp"
 #include "progress.hpp"
 
@@ -96,33 +97,6 @@ struct MapOptions {
   double new_node_likelihood_floor = methodPreset("default").topology.new_node_likelihood_floor;
   CLI::Option* new_node_floor_given = nullptr;
 };
-
-/// Per observation of the map (this run's and earlier runs'): where it came from.
-struct ObservationOrigin {
-  int run = 0;                             ///< 0 for the first `map` run, +1 per --resume
-  std::int64_t representative_frame = -1;  ///< frame number within that run
-};
-
-std::string encodeOrigins(const std::vector<ObservationOrigin>& origins) {
-  std::ostringstream out;
-  out << "toposlam-map-origins 1\n";
-  for (const auto& o : origins) out << o.run << ' ' << o.representative_frame << '\n';
-  return out.str();
-}
-
-std::vector<ObservationOrigin> decodeOrigins(const std::string& text, int observations) {
-  std::istringstream in(text);
-  std::string magic;
-  int version = 0;
-  std::vector<ObservationOrigin> origins;
-  if (in >> magic >> version && magic == "toposlam-map-origins" && version == 1) {
-    ObservationOrigin o;
-    while (in >> o.run >> o.representative_frame) origins.push_back(o);
-  }
-  // A map written by another tool: unknown origins.
-  origins.resize(static_cast<std::size_t>(observations), ObservationOrigin{-1, -1});
-  return origins;
-}
 
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -198,8 +172,8 @@ NgramSimilarityConfig similarityConfig(const MapOptions& o, const MethodPreset& 
 /// origins of its observations.
 struct StartingFilter {
   std::unique_ptr<ParticleFilterTopologyStage> topology;
-  std::vector<ObservationOrigin> origins;  ///< per observation so far (the resumed map's)
-  int run_number = 0;                      ///< this run's, in the origins
+  MapApplicationData origins;  ///< per observation so far (the resumed map's), then this run's
+  int run_number = 0;          ///< this run's, in the origins
 };
 
 /// --resume: the saved map, refused (ConfigError naming the option that would accept it) when it was made
@@ -246,9 +220,10 @@ StartingFilter resumedFilter(const MapOptions& o, const NgramSimilarity& similar
   StartingFilter start;
   start.topology =
       std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, TopologyStageConfig{});
-  start.origins = decodeOrigins(loaded.application_data, loaded.filter->observationCount());
+  start.origins = decodeMapApplicationData(loaded.application_data, loaded.filter->observationCount());
   start.topology->adoptMap(std::move(loaded));
-  for (const auto& origin : start.origins) start.run_number = std::max(start.run_number, origin.run + 1);
+  for (const auto& origin : start.origins.origins) start.run_number = std::max(start.run_number, origin.run + 1);
+  start.run_number = std::max(start.run_number, static_cast<int>(start.origins.run_frames.size()));
   std::cerr << "map: resumed " << o.resume << " (" << start.topology->observations() << " places)\n";
   return start;
 }
@@ -300,12 +275,41 @@ struct Traversals {
   std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
 };
 
+/// Where a kept place of this run came from and the filter's estimate after its step (`e`), for the map's
+/// application data.
+ObservationOrigin originOf(const SegmentedPlace& place, int run_number, const TopologyEstimate& e) {
+  ObservationOrigin o;
+  o.step_node = e.current_node;
+  o.node_probability = e.current_node_probability;
+  o.best_topology_probability = e.best.probability;
+  o.effective_sample_size = e.effective_sample_size;
+  o.run = run_number;
+  o.representative_frame = place.representative_frame;
+  o.first_frame = place.first_frame;
+  o.last_frame = place.last_frame;
+  o.first_time_s = place.first_time_s;
+  o.last_time_s = place.last_time_s;
+  o.keypoints = place.representative_keypoints;
+  o.end = placeEndName(place.end);
+  return o;
+}
+
+/// This run's frame count and the start time of each of its traversals, once the sources are done.
+void finishRunOrigins(MapApplicationData& origins, int run_number, const SegmentationRun& all) {
+  origins.run_frames.resize(std::max(origins.run_frames.size(), static_cast<std::size_t>(run_number) + 1), 0);
+  origins.run_frames[static_cast<std::size_t>(run_number)] = static_cast<std::int64_t>(all.frames.size());
+  for (MapTraversal& t : origins.traversals) {
+    if (t.run == run_number && t.start_frame >= 0 && static_cast<std::size_t>(t.start_frame) < all.frames.size())
+      t.start_time_s = all.frames[static_cast<std::size_t>(t.start_frame)].time_s;
+  }
+}
+
 /// Every source, one traversal after the other, through the runner: fingerprint, segment, and a filter step
 /// for every kept place; `origins` gets one entry per step; with `keep_fingerprints`, every frame's
 /// fingerprint (the frame-level closures by visits need them at the end).
 Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
                            FiedlerSegmentationStage& segmentation_stage, std::optional<MotionReplay>& motion,
-                           std::vector<ObservationOrigin>& origins, int run_number, bool keep_fingerprints) {
+                           MapApplicationData& origins, int run_number, bool keep_fingerprints) {
   Traversals done;
   Progress* progress = nullptr;  // the current source's progress line (cleared before a log line)
   auto mapPlace = [&](const SegmentedPlace& place) {
@@ -314,8 +318,8 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
     const auto start = std::chrono::steady_clock::now();
     const MappedPlace mapped = *runner.mapPlace(place);
     if (!done.timing.empty()) done.timing.back().filter_ms = *done.timing.back().filter_ms + msSince(start);
-    origins.push_back(ObservationOrigin{run_number, place.representative_frame});
     const TopologyEstimate& e = mapped.estimate;
+    origins.origins.push_back(originOf(place, run_number, e));
     if (o.quiet) return;
     std::fprintf(stderr,
                  "map: place %lld (frames %lld-%lld) -> node %d p=%.2f, best topology p=%.2f, ESS %.0f\n",
@@ -328,6 +332,8 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
     std::unique_ptr<FrameSource> source = openSource(uri);
     if (!o.quiet) std::cerr << "map: " << source->describe() << "\n";
     runner.beginTraversal();  // fresh segmentation window per traversal
+    origins.traversals.push_back(MapTraversal{run_number, static_cast<std::int64_t>(runner.run().frames.size()),
+                                              std::numeric_limits<double>::quiet_NaN(), absoluteSourceUri(uri)});
     // Each traversal has its own clock, with any step back inside it cut out (the segmentation stage's;
     // docs/reliability.md, "Clock jumps"); the next source starts its own, so where it goes back a new
     // traversal begins (frames.csv).
@@ -654,7 +660,8 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
   const MapSettings made_with = mapSettingsOf(vpack, similarity_config, segmenter_config, filter.config(), evidence,
                                               o.sources.front());  // the first traversal's source
-  MapStore::save(map_path, filter, encodeOrigins(start.origins), made_with);
+  finishRunOrigins(start.origins, start.run_number, all);
+  MapStore::save(map_path, filter, encodeMapApplicationData(start.origins), made_with);
 
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter.estimate(3);

@@ -7,6 +7,9 @@
 //
 // RUN_DIR may be `lcmlog:FILE`, toposlamd's recorded LCM log: it is turned into the run folder FILE.run/
 // first (lcmlog_run_folder.hpp; channel names from toposlamd's config, found as toposlamd finds it).
+// RUN_DIR may be a map file (map.tsm of `toposlam map` or toposlamd): it is exported into a temporary run
+// folder (map_desk.hpp, as `toposlam export` does), reported, and the folder removed; the page goes beside
+// the map (MAP without its extension + ".report.html") unless --out says otherwise.
 #include <algorithm>
 #include <cstdlib>
 #include <ctime>
@@ -14,6 +17,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +33,8 @@
 #include "toposlam/run_folder/run_folder.hpp"
 #include "toposlam/io/image_file.hpp"
 #include "lcmlog_run_folder.hpp"
+#include "map_desk.hpp"
+#include "toposlam/platform/file_system.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/config/daemon_config.hpp"
@@ -49,6 +55,7 @@ struct ReportCommandOptions {
   eval::EvalOptions eval;
   int thumbnails = 96;
   bool json = false;
+  std::string map;  ///< the map file RUN_DIR named, when it was one (run_dir is then its export)
 };
 
 std::vector<fs::path> frameFolders(const ReportCommandOptions& o, std::vector<std::string>& warnings) {
@@ -185,7 +192,27 @@ std::string runFolderOf(const std::string& run_dir) {
   return folder;
 }
 
+/// A map file given as RUN_DIR: exported into `folder`; the report's default file and title follow the map.
+void exportMapForReport(ReportCommandOptions& o, const fs::path& folder) {
+  const fs::path map_path(o.run_dir);
+  const DeskMap map = openDeskMap(map_path, "report");
+  writeExportedRun(map, folder);
+  std::cerr << "report: exported " << map_path.string() << " (" << map.topology->observations() << " places, "
+            << nodeCount(map) << " nodes) into a temporary run folder\n";
+  if (o.out.empty()) o.out = (map_path.parent_path() / map_path.stem()).string() + ".report.html";
+  if (o.title.empty()) o.title = "toposlam report: " + map_path.filename().string();
+  o.map = o.run_dir;
+  o.run_dir = folder.string();
+}
+
 void runReport(ReportCommandOptions o) {
+  std::optional<TemporaryFolder> exported;
+  std::error_code error;
+  const bool missing_map = !fs::exists(o.run_dir, error) && fs::path(o.run_dir).extension() == ".tsm";
+  if (fs::is_regular_file(o.run_dir, error) || missing_map) {
+    exported.emplace("toposlam-report-");
+    exportMapForReport(o, exported->path() / "run");
+  }
   o.run_dir = runFolderOf(o.run_dir);
   eval::ReportInputs in;
   in.run = loadRun(o.run_dir);
@@ -249,7 +276,7 @@ void runReport(ReportCommandOptions o) {
     json.beginObject()
         .field("report", out.string())
         .field("bytes", static_cast<std::int64_t>(fs::file_size(out)))
-        .field("run", o.run_dir)
+        .field("run", o.map.empty() ? o.run_dir : o.map)
         .field("frames", in.run.frames.size())
         .field("places", in.run.places.size())
         .field("thumbnails", thumbnails)
@@ -269,14 +296,15 @@ void addReportCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("report",
                                  "One self-contained HTML page with the figures and tables of a run folder");
   cmd->add_option("run_dir", options->run_dir,
-                  "Run folder written by `toposlam segment` or `toposlam map`, or lcmlog:FILE (toposlamd's LCM log, "
-                  "converted into FILE.run/)")
+                  "Run folder written by `toposlam segment` or `toposlam map`, a map file (map.tsm, exported to a "
+                  "temporary run folder first), or lcmlog:FILE (toposlamd's LCM log, converted into FILE.run/)")
       ->required();
   cmd->add_option("--truth", options->truth,
                   "Ground truth as for `toposlam eval` (adds the evaluation tables)");
   cmd->add_option("--frames", options->frames,
                   "Folder of the run's frames, one per source in order (thumbnails)");
-  cmd->add_option("--out", options->out, "Output HTML file (default RUN_DIR/report.html)");
+  cmd->add_option("--out", options->out,
+                  "Output HTML file (default RUN_DIR/report.html; for a map file, MAP.report.html beside it)");
   cmd->add_option("--title", options->title, "Page title");
   cmd->add_option("--figures", options->figures,
                   "Also write each figure as a standalone SVG file into this folder");

@@ -20,5 +20,8 @@ void addConfigCommand(CLI::App& app);
 void addSimilarityCommand(CLI::App& app);
 void addLocalizeCommand(CLI::App& app);
 void addRecognitionCommand(CLI::App& app);
+/// `toposlam map-info MAP` and `toposlam export MAP --out DIR` (command_map_info.cpp).
+void addMapInfoCommand(CLI::App& app);
+void addExportCommand(CLI::App& app);
 
 }  // namespace toposlam::cli

@@ -35,6 +35,8 @@ int run(int argc, char** argv) {
   toposlam::cli::addSimilarityCommand(app);
   toposlam::cli::addLocalizeCommand(app);
   toposlam::cli::addRecognitionCommand(app);
+  toposlam::cli::addMapInfoCommand(app);
+  toposlam::cli::addExportCommand(app);
   return toposlam::cli::runCommandLine(app, argc, argv, "toposlam");
 }
 

@@ -34,14 +34,12 @@ std::string checkSourceUri(const std::string& uri) {
         return "'" + uri + "' has no scheme and is no existing file or folder (e.g. images:DIR, v4l2:/dev/video0)";
       return "";
     }
-    std::string known;
-    for (const auto& [scheme, usage] : registeredFrameSourceSchemes()) {
-      if (scheme == parsed.scheme) return "";
-      known += "\n  " + usage;
-    }
-    return "'" + uri + "': unknown scheme '" + parsed.scheme + ":'; use one of:" + known;
+    checkFrameSourceUri(uri);  // the scheme, its keys and values, as the start judges them; nothing opened
+    return "";
   } catch (const std::exception& e) {
-    return e.what();
+    // The factory says "source '<uri>': ..."; the caller names the key (source:) already.
+    const std::string problem = e.what();
+    return problem.rfind("source '", 0) == 0 ? problem.substr(7) : problem;
   }
 }
 

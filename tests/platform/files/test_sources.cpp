@@ -319,3 +319,20 @@ TEST_CASE("GIVEN a short video file WHEN played THEN its frames come out in orde
     CHECK(count == 5);
   }
 }
+
+SCENARIO("GIVEN the simulator and an image folder WHEN asked their state THEN they say what they are, not a camera") {
+  SimFrameSource sim(simConfigFromUri(parseSourceUri("sim:office?size=64x48")));
+  CHECK(sim.state().kind == SourceKind::Simulator);
+  ImageFilesSource images(std::string(TOPOSLAM_SAMPLES_DIR) + "/samples", 1.0);
+  CHECK(images.state().kind == SourceKind::ImageFiles);
+}
+
+SCENARIO("GIVEN source URIs with a bad option WHEN checked without opening THEN the opener's refusal comes, "
+         "naming the key") {
+  CHECK_NOTHROW(checkFrameSourceUri("sim:office?fps=5"));
+  CHECK_NOTHROW(checkFrameSourceUri("images:/nonexistent/folder?fps=2"));  // nothing is opened
+  CHECK_THROWS_WITH(checkFrameSourceUri("sim:office?fps=fast"), Catch::Contains("fps"));
+  CHECK_THROWS_WITH(checkFrameSourceUri("images:/x?speed=2"), Catch::Contains("speed"));
+  CHECK_THROWS_WITH(checkFrameSourceUri("video:/x.mp4?rate=0"), Catch::Contains("rate"));
+  CHECK_THROWS_WITH(checkFrameSourceUri("bogus:thing"), Catch::Contains("unknown scheme 'bogus:'"));
+}

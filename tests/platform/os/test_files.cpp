@@ -96,6 +96,35 @@ SCENARIO(
   fs::remove_all(dir);
 }
 
+SCENARIO("GIVEN a lock held WHEN it is released THEN its lock file is gone, unless the name leads elsewhere by then") {
+  const TempFolder temp("lock-release");
+  const fs::path& dir = temp.path;
+  const fs::path file = dir / "map.tsm.lock";
+  FileLockFailure failure;
+  {
+    std::optional<FileLock> lock = FileLock::tryAcquire(file, failure);
+    REQUIRE(lock);
+    CHECK(fs::exists(file));
+    FileLock moved = std::move(*lock);
+    lock.reset();
+    CHECK(fs::exists(file));  // the moved lock still holds it
+  }
+  CHECK_FALSE(fs::exists(file));  // no stale lock after a clean release
+  {
+    std::optional<FileLock> lock = FileLock::tryAcquire(file, failure);
+    REQUIRE(lock);
+    fs::remove(file);
+    { std::ofstream(file) << "someone else's"; }  // another file under the name: not ours to remove
+  }
+  CHECK(readAll(file) == "someone else's");
+  {
+    std::optional<FileLock> lock = FileLock::tryAcquire(file, failure);  // a lock file left by others
+    REQUIRE(lock);
+  }
+  CHECK_FALSE(fs::exists(file));
+  fs::remove_all(dir);
+}
+
 SCENARIO("GIVEN a lock file that is a symbolic link or a hard link to another file WHEN locked THEN the other "
          "file is never written") {
   const TempFolder temp("lock-links");
@@ -114,6 +143,7 @@ SCENARIO("GIVEN a lock file that is a symbolic link or a hard link to another fi
     CHECK(lock);  // locked, but not truncated nor written
   }
   CHECK(readAll(dir / "victim") == "keep me");
+  CHECK(fs::exists(dir / "map.tsm.lock"));  // a second name of another file: never removed
   fs::remove_all(dir);
 }
 

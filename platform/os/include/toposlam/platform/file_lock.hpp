@@ -2,7 +2,12 @@
 // process asking for it is refused at once (no waiting). The holder writes its process id into the file,
 // so that a refused process can say who holds it. When the lock file cannot be created because its
 // folder is read-only or not ours, the folder itself is locked instead (a second process is still
-// refused). The lock goes with the last descriptor: the object closes it. Linux (flock).
+// refused). The lock goes with the last descriptor: the object closes it, and first removes the lock file
+// when it is still the one it locked (same device and inode, a regular file of one name), so that a clean
+// exit leaves no stale "*.lock" behind; a file someone put in its place, a hard link or the folder locked
+// instead is never removed. Because a lock file may vanish, acquiring checks after flock() that the name
+// still leads to the file locked (else someone released and removed it meanwhile) and tries again.
+// Linux (flock).
 //
 // Thread-safety: acquire from any thread; one owner per object. flock locks are per open file, so a
 // second FileLock on the same file in the same process is refused too.
@@ -35,9 +40,13 @@ class FileLock {
   const std::filesystem::path& lockedPath() const { return locked_; }
 
  private:
-  FileLock(int fd, std::filesystem::path locked) : fd_(fd), locked_(std::move(locked)) {}
+  FileLock(int fd, std::filesystem::path locked, bool remove_at_release)
+      : fd_(fd), locked_(std::move(locked)), remove_at_release_(remove_at_release) {}
+  static std::optional<FileLock> tryAcquireOnce(const std::filesystem::path& lock_file, FileLockFailure& failure);
+  void release();
   int fd_ = -1;
   std::filesystem::path locked_;
+  bool remove_at_release_ = false;  ///< a lock file of ours (not the folder, not a hard link)
 };
 
 }  // namespace toposlam

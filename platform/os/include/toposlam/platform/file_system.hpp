@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 namespace toposlam {
 
@@ -51,5 +52,20 @@ int removeFile(const std::filesystem::path& path);
 /// The largest file this process may write (RLIMIT_FSIZE, the shell's ulimit -f), bytes; 0 when unlimited.
 /// A write beyond it fails with EFBIG once SIGXFSZ is ignored (signal_mask.hpp, ignoreSignals).
 std::uint64_t fileSizeLimitBytes();
+
+/// A new private folder (mode 0700) under $TMPDIR (else /tmp), named "<prefix>XXXXXX", removed with all it
+/// holds when the object goes. For a command's intermediate files (`toposlam report MAP`'s run folder).
+class TemporaryFolder {
+ public:
+  /// Throws std::runtime_error naming the folder and the reason when it cannot be created.
+  explicit TemporaryFolder(const std::string& prefix);
+  ~TemporaryFolder();
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace toposlam
