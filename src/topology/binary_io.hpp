@@ -27,6 +27,19 @@ class BinaryWriter {
     u64(text.size());
     out_.append(text);
   }
+  /// bytes() of what `fill(std::string&)` appends to the buffer: the size is written in after (no copy).
+  template <typename Fill>
+  void bytesFrom(Fill&& fill) {
+    const std::size_t at = out_.size();
+    u64(0);
+    fill(out_);
+    patchU64(at, out_.size() - at - 8);
+  }
+  /// Overwrites the 8 bytes at `at` (written before) with `v`.
+  void patchU64(std::size_t at, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) out_[at + static_cast<std::size_t>(i)] = static_cast<char>(v >> (8 * i));
+  }
+  void reserve(std::size_t bytes) { out_.reserve(bytes); }
   const std::string& data() const { return out_; }
   std::string take() { return std::move(out_); }
 
