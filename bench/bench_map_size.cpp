@@ -1,6 +1,7 @@
-// `toposlam-bench map-size`: what a new place costs as the map grows to 10,000 places (issue 18: under
-// 20 ms and 200 MB resident with 500 particles), with the candidate index (docs/topology.md, "Large
-// maps"), and how often its decision equals the exhaustive comparison's.
+// `toposlam-bench map-size`: what a new place costs as the map grows (issue 18: 10,000 places under 20 ms
+// and 200 MB resident with 500 particles; issue 38: 100,000 places, < 500 MB), with the candidate index
+// (docs/topology.md, "Large maps"), how often its decision equals the exhaustive comparison's, and what
+// the map file of the end state costs to save and to load.
 //
 // The run is synthetic but made of real fingerprints: each place's prototype is one of the bundled
 // sample frames' VPACK fingerprints (its edges, subregions and keypoints) with its descriptor bits
