@@ -8,11 +8,14 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace toposlam::topology_detail {
 
 class BinaryWriter {
  public:
+  /// Appends to `start` (moved in, not copied; take() hands it back).
+  explicit BinaryWriter(std::string start = {}) : out_(std::move(start)) {}
   void u8(std::uint8_t v) { out_.push_back(static_cast<char>(v)); }
   void u32(std::uint32_t v) {
     for (int i = 0; i < 4; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));

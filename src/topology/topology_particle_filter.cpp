@@ -772,7 +772,7 @@ void FrozenTopologyState::saveState(std::ostream& out) const {
 }
 
 void FrozenTopologyState::appendState(std::string& out) const {
-  BinaryWriter w;
+  BinaryWriter w(std::move(out));  // written in place at the end of `out`, given back below
   w.i32(config_.particles);
   w.f64(config_.alpha);
   w.f64(config_.new_node_probability);
@@ -798,7 +798,7 @@ void FrozenTopologyState::appendState(std::string& out) const {
     }
   // A guess that avoids regrowing a buffer of hundreds of MB: descriptors plus ~3 KB per fingerprint
   // (keypoints, subregions) plus 12 bytes per history record.
-  w.reserve(descriptor_bytes + 3200u * alive + 24u * fingerprints_.size() + 4096u);
+  w.reserve(w.data().size() + descriptor_bytes + 3200u * alive + 24u * fingerprints_.size() + 4096u);
   w.u32(alive);
   for (std::size_t o = 0; o < fingerprints_.size(); ++o) {
     if (!fingerprints_[o]) continue;
@@ -835,11 +835,7 @@ void FrozenTopologyState::appendState(std::string& out) const {
   w.u8(config_.new_node_entropy ? 1 : 0);
   // Third extension block (absent in maps written before it: those had no floor).
   w.f64(config_.new_node_likelihood_floor);
-  if (out.empty()) {
-    out = w.take();
-  } else {
-    out += w.data();
-  }
+  out = w.take();
 }
 
 std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
