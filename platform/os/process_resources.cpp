@@ -1,8 +1,10 @@
 // Process CPUs and resident memory for the benchmarks; see the header.
 #include "toposlam/platform/process_resources.hpp"
 
+#include <malloc.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -59,6 +61,13 @@ bool resetPeakResident() {
   clear << "5";
   clear.flush();
   return static_cast<bool>(clear);
+}
+
+bool reuseFreedMemory(std::size_t heap_block_bytes, std::size_t keep_free_bytes) {
+  const auto clamp = [](std::size_t v) { return static_cast<int>(std::min<std::size_t>(v, 1u << 30)); };
+  // Setting either also stops glibc's own adjustment of both (its "dynamic" thresholds).
+  return ::mallopt(M_MMAP_THRESHOLD, clamp(heap_block_bytes)) == 1 &&
+         ::mallopt(M_TRIM_THRESHOLD, clamp(keep_free_bytes)) == 1;
 }
 
 }  // namespace toposlam

@@ -2,6 +2,7 @@
 #include "toposlam/fingerprint/fingerprint.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cctype>
 #include <cstring>
@@ -106,96 +107,119 @@ static_assert(std::endian::native == std::endian::little, "serialisation assumes
 constexpr char kMagic[4] = {'V', 'P', 'K', '1'};
 constexpr std::uint32_t kMaxCount = 1u << 24;  // sanity bound against garbage lengths
 
-template <typename T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
+/// Where a fingerprint is written: a stream, or the end of a byte string (no stream, no copy).
+struct StreamSink {
+  std::ostream& out;
+  void write(const void* data, std::size_t size) {
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+};
+struct StringSink {
+  std::string& out;
+  void write(const void* data, std::size_t size) { out.append(static_cast<const char*>(data), size); }
+};
+
+/// Where a fingerprint is read from. reservable(): how many of `count` elements of `size` bytes can still
+/// be there (a stream cannot say: 0, so its containers grow as the data arrives; a corrupt count then
+/// fails with "truncated" rather than allocating for what it claims).
+struct StreamSource {
+  std::istream& in;
+  bool read(void* data, std::size_t size) {
+    in.read(static_cast<char*>(data), static_cast<std::streamsize>(size));
+    return static_cast<bool>(in);
+  }
+  std::size_t reservable(std::uint32_t, std::size_t) const { return 0; }
+};
+struct ViewSource {
+  std::string_view bytes;
+  bool read(void* data, std::size_t size) {
+    if (bytes.size() < size) return false;
+    std::memcpy(data, bytes.data(), size);
+    bytes.remove_prefix(size);
+    return true;
+  }
+  std::size_t reservable(std::uint32_t count, std::size_t size) const {
+    return std::min<std::size_t>(count, bytes.size() / size);
+  }
+};
+
+template <typename Sink, typename T>
+void put(Sink& out, const T& v) {
+  out.write(&v, sizeof(T));
 }
 
-template <typename T>
-T get(std::istream& in, const char* what) {
+template <typename T, typename Source>
+T get(Source& in, const char* what) {
   T v{};
-  in.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!in) throw std::runtime_error(std::string("fingerprint data truncated while reading ") + what);
+  if (!in.read(&v, sizeof(T))) throw std::runtime_error(std::string("fingerprint data truncated while reading ") + what);
   return v;
 }
 
-std::uint32_t getCount(std::istream& in, const char* what) {
+template <typename Source>
+std::uint32_t getCount(Source& in, const char* what) {
   const auto n = get<std::uint32_t>(in, what);
   if (n > kMaxCount) throw std::runtime_error(std::string("fingerprint data corrupt: implausible ") + what);
   return n;
 }
 
-}  // namespace
-
-void writeFingerprint(std::ostream& out, const Fingerprint& f) {
+template <typename Sink>
+void writeTo(Sink& out, const Fingerprint& f) {
   out.write(kMagic, 4);
-  put<std::int32_t>(out, f.image_width);
-  put<std::int32_t>(out, f.image_height);
-  put<std::uint8_t>(out, static_cast<std::uint8_t>(f.backend));
-  put<std::uint32_t>(out, static_cast<std::uint32_t>(f.edge_columns.size()));
-  for (int c : f.edge_columns) put<std::int32_t>(out, c);
-  put<std::uint32_t>(out, static_cast<std::uint32_t>(f.subregions.size()));
+  put<Sink, std::int32_t>(out, f.image_width);
+  put<Sink, std::int32_t>(out, f.image_height);
+  put<Sink, std::uint8_t>(out, static_cast<std::uint8_t>(f.backend));
+  put<Sink, std::uint32_t>(out, static_cast<std::uint32_t>(f.edge_columns.size()));
+  for (int c : f.edge_columns) put<Sink, std::int32_t>(out, c);
+  put<Sink, std::uint32_t>(out, static_cast<std::uint32_t>(f.subregions.size()));
   for (const Subregion& s : f.subregions) {
-    put<std::int32_t>(out, s.column_begin);
-    put<std::int32_t>(out, s.column_end);
-    put<std::int32_t>(out, s.keypoint_begin);
-    put<std::int32_t>(out, s.keypoint_end);
-    out.write(reinterpret_cast<const char*>(s.histogram.data()), sizeof(float) * kHistogramBins);
+    put<Sink, std::int32_t>(out, s.column_begin);
+    put<Sink, std::int32_t>(out, s.column_end);
+    put<Sink, std::int32_t>(out, s.keypoint_begin);
+    put<Sink, std::int32_t>(out, s.keypoint_end);
+    out.write(s.histogram.data(), sizeof(float) * kHistogramBins);
   }
-  put<std::uint32_t>(out, static_cast<std::uint32_t>(f.keypoints.size()));
+  put<Sink, std::uint32_t>(out, static_cast<std::uint32_t>(f.keypoints.size()));
   for (const cv::KeyPoint& k : f.keypoints) {
-    put<float>(out, k.pt.x);
-    put<float>(out, k.pt.y);
-    put<float>(out, k.size);
-    put<float>(out, k.angle);
-    put<float>(out, k.response);
-    put<std::int32_t>(out, k.octave);
-    put<std::int32_t>(out, k.class_id);
+    const std::array<float, 5> reals{k.pt.x, k.pt.y, k.size, k.angle, k.response};
+    const std::array<std::int32_t, 2> ints{k.octave, k.class_id};
+    out.write(reals.data(), sizeof(reals));
+    out.write(ints.data(), sizeof(ints));
   }
-  put<std::int32_t>(out, f.descriptors.rows);
-  put<std::int32_t>(out, f.descriptors.cols);
-  put<std::int32_t>(out, f.descriptors.empty() ? 0 : f.descriptors.type());
+  put<Sink, std::int32_t>(out, f.descriptors.rows);
+  put<Sink, std::int32_t>(out, f.descriptors.cols);
+  put<Sink, std::int32_t>(out, f.descriptors.empty() ? 0 : f.descriptors.type());
   for (int r = 0; r < f.descriptors.rows; ++r)
-    out.write(reinterpret_cast<const char*>(f.descriptors.ptr(r)),
-              static_cast<std::streamsize>(f.descriptors.cols * f.descriptors.elemSize()));
+    out.write(f.descriptors.ptr(r), f.descriptors.cols * f.descriptors.elemSize());
 }
 
-Fingerprint readFingerprint(std::istream& in) {
-  char magic[4] = {};
-  in.read(magic, 4);
-  if (!in) throw std::runtime_error("fingerprint data truncated while reading the magic");
-  if (std::memcmp(magic, kMagic, 4) != 0) throw std::runtime_error("not a fingerprint (bad magic)");
-  Fingerprint f;
-  f.image_width = get<std::int32_t>(in, "image width");
-  f.image_height = get<std::int32_t>(in, "image height");
-  const auto backend = get<std::uint8_t>(in, "backend");
-  if (backend > static_cast<std::uint8_t>(KeypointBackend::Akaze))
-    throw std::runtime_error("fingerprint data corrupt: unknown keypoint backend");
-  f.backend = static_cast<KeypointBackend>(backend);
-  // Containers grow element by element as the data arrives, so a corrupt count fails with
-  // "truncated" after reading what is there instead of allocating for the claimed size.
+template <typename Source>
+void readEdgesAndSubregions(Source& in, Fingerprint& f) {
   const std::uint32_t edge_count = getCount(in, "edge count");
+  f.edge_columns.reserve(in.reservable(edge_count, sizeof(std::int32_t)));
   for (std::uint32_t i = 0; i < edge_count; ++i) f.edge_columns.push_back(get<std::int32_t>(in, "edge column"));
   const std::uint32_t subregion_count = getCount(in, "subregion count");
+  f.subregions.reserve(in.reservable(subregion_count, 4 * sizeof(std::int32_t) + sizeof(HclHistogramBins)));
   for (std::uint32_t i = 0; i < subregion_count; ++i) {
     Subregion& s = f.subregions.emplace_back();
     s.column_begin = get<std::int32_t>(in, "subregion");
     s.column_end = get<std::int32_t>(in, "subregion");
     s.keypoint_begin = get<std::int32_t>(in, "subregion");
     s.keypoint_end = get<std::int32_t>(in, "subregion");
-    in.read(reinterpret_cast<char*>(s.histogram.data()), sizeof(float) * kHistogramBins);
-    if (!in) throw std::runtime_error("fingerprint data truncated while reading a histogram");
+    if (!in.read(s.histogram.data(), sizeof(float) * kHistogramBins))
+      throw std::runtime_error("fingerprint data truncated while reading a histogram");
   }
+}
+
+template <typename Source>
+void readKeypointsAndDescriptors(Source& in, Fingerprint& f) {
   const std::uint32_t keypoint_count = getCount(in, "keypoint count");
+  f.keypoints.reserve(in.reservable(keypoint_count, 5 * sizeof(float) + 2 * sizeof(std::int32_t)));
   for (std::uint32_t i = 0; i < keypoint_count; ++i) {
-    cv::KeyPoint& k = f.keypoints.emplace_back();
-    k.pt.x = get<float>(in, "keypoint");
-    k.pt.y = get<float>(in, "keypoint");
-    k.size = get<float>(in, "keypoint");
-    k.angle = get<float>(in, "keypoint");
-    k.response = get<float>(in, "keypoint");
-    k.octave = get<std::int32_t>(in, "keypoint");
-    k.class_id = get<std::int32_t>(in, "keypoint");
+    std::array<float, 5> reals{};
+    std::array<std::int32_t, 2> ints{};
+    if (!in.read(reals.data(), sizeof(reals)) || !in.read(ints.data(), sizeof(ints)))
+      throw std::runtime_error("fingerprint data truncated while reading keypoint");
+    f.keypoints.emplace_back(cv::Point2f(reals[0], reals[1]), reals[2], reals[3], reals[4], ints[0], ints[1]);
   }
   const auto rows = get<std::int32_t>(in, "descriptor rows");
   const auto cols = get<std::int32_t>(in, "descriptor cols");
@@ -205,13 +229,50 @@ Fingerprint readFingerprint(std::istream& in) {
     throw std::runtime_error("fingerprint data corrupt: bad descriptor matrix header");
   if (rows > 0) {
     f.descriptors.create(rows, cols, type);
-    in.read(reinterpret_cast<char*>(f.descriptors.data),
-            static_cast<std::streamsize>(f.descriptors.total() * f.descriptors.elemSize()));
-    if (!in) throw std::runtime_error("fingerprint data truncated while reading descriptors");
+    if (!in.read(f.descriptors.data, f.descriptors.total() * f.descriptors.elemSize()))
+      throw std::runtime_error("fingerprint data truncated while reading descriptors");
   }
+}
+
+template <typename Source>
+Fingerprint readFrom(Source& in) {
+  char magic[4] = {};
+  if (!in.read(magic, 4)) throw std::runtime_error("fingerprint data truncated while reading the magic");
+  if (std::memcmp(magic, kMagic, 4) != 0) throw std::runtime_error("not a fingerprint (bad magic)");
+  Fingerprint f;
+  f.image_width = get<std::int32_t>(in, "image width");
+  f.image_height = get<std::int32_t>(in, "image height");
+  const auto backend = get<std::uint8_t>(in, "backend");
+  if (backend > static_cast<std::uint8_t>(KeypointBackend::Akaze))
+    throw std::runtime_error("fingerprint data corrupt: unknown keypoint backend");
+  f.backend = static_cast<KeypointBackend>(backend);
+  readEdgesAndSubregions(in, f);
+  readKeypointsAndDescriptors(in, f);
   if (std::string problem = f.validate(); !problem.empty())
     throw std::runtime_error("fingerprint data corrupt: " + problem);
   return f;
+}
+
+}  // namespace
+
+void writeFingerprint(std::ostream& out, const Fingerprint& f) {
+  StreamSink sink{out};
+  writeTo(sink, f);
+}
+
+void appendFingerprintBytes(std::string& out, const Fingerprint& f) {
+  StringSink sink{out};
+  writeTo(sink, f);
+}
+
+Fingerprint readFingerprint(std::istream& in) {
+  StreamSource source{in};
+  return readFrom(source);
+}
+
+Fingerprint fingerprintFromBytes(std::string_view bytes) {
+  ViewSource source{bytes};
+  return readFrom(source);
 }
 
 }  // namespace toposlam

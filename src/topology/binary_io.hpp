@@ -8,11 +8,14 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace toposlam::topology_detail {
 
 class BinaryWriter {
  public:
+  /// Appends to `start` (moved in, not copied; take() hands it back).
+  explicit BinaryWriter(std::string start = {}) : out_(std::move(start)) {}
   void u8(std::uint8_t v) { out_.push_back(static_cast<char>(v)); }
   void u32(std::uint32_t v) {
     for (int i = 0; i < 4; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));
@@ -27,6 +30,19 @@ class BinaryWriter {
     u64(text.size());
     out_.append(text);
   }
+  /// bytes() of what `fill(std::string&)` appends to the buffer: the size is written in after (no copy).
+  template <typename Fill>
+  void bytesFrom(Fill&& fill) {
+    const std::size_t at = out_.size();
+    u64(0);
+    fill(out_);
+    patchU64(at, out_.size() - at - 8);
+  }
+  /// Overwrites the 8 bytes at `at` (written before) with `v`.
+  void patchU64(std::size_t at, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) out_[at + static_cast<std::size_t>(i)] = static_cast<char>(v >> (8 * i));
+  }
+  void reserve(std::size_t bytes) { out_.reserve(bytes); }
   const std::string& data() const { return out_; }
   std::string take() { return std::move(out_); }
 

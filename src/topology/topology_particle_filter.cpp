@@ -766,7 +766,13 @@ void TopologyParticleFilter::saveState(std::ostream& out) const { freeze().saveS
 // another thread meanwhile. A history record's parent is only changed by its destructor, once nothing
 // else (this state included) holds the record.
 void FrozenTopologyState::saveState(std::ostream& out) const {
-  BinaryWriter w;
+  std::string data;
+  appendState(data);
+  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+}
+
+void FrozenTopologyState::appendState(std::string& out) const {
+  BinaryWriter w(std::move(out));  // written in place at the end of `out`, given back below
   w.i32(config_.particles);
   w.f64(config_.alpha);
   w.f64(config_.new_node_probability);
@@ -784,14 +790,20 @@ void FrozenTopologyState::saveState(std::ostream& out) const {
   w.i64(degenerate_steps_);
 
   std::uint32_t alive = 0;
-  for (const auto& f : fingerprints_) alive += f ? 1 : 0;
+  std::size_t descriptor_bytes = 0;
+  for (const auto& f : fingerprints_)
+    if (f) {
+      ++alive;
+      descriptor_bytes += f->descriptors.total() * f->descriptors.elemSize();
+    }
+  // A guess that avoids regrowing a buffer of hundreds of MB: descriptors plus ~3 KB per fingerprint
+  // (keypoints, subregions) plus 12 bytes per history record.
+  w.reserve(w.data().size() + descriptor_bytes + 3200u * alive + 24u * fingerprints_.size() + 4096u);
   w.u32(alive);
   for (std::size_t o = 0; o < fingerprints_.size(); ++o) {
     if (!fingerprints_[o]) continue;
-    std::ostringstream blob;
-    writeFingerprint(blob, *fingerprints_[o]);
     w.i32(static_cast<std::int32_t>(o));
-    w.bytes(blob.str());
+    w.bytesFrom([&](std::string& bytes) { appendFingerprintBytes(bytes, *fingerprints_[o]); });
   }
 
   // History records reachable from the particles, parents before children (observation ascending).
@@ -823,8 +835,7 @@ void FrozenTopologyState::saveState(std::ostream& out) const {
   w.u8(config_.new_node_entropy ? 1 : 0);
   // Third extension block (absent in maps written before it: those had no floor).
   w.f64(config_.new_node_likelihood_floor);
-  const std::string& data = w.data();
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  out = w.take();
 }
 
 std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
@@ -834,6 +845,11 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
   while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
     data.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
   }
+  return loadState(std::string_view(data), similarity);
+}
+
+std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
+    std::string_view data, const SimilarityMeasure& similarity) {
   BinaryReader r(data);
   TopologyFilterConfig config;
   config.particles = r.i32("config");
@@ -874,10 +890,10 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     if (o < 0 || o >= observations || filter->fingerprints_[idx(o)]) {
       throw std::runtime_error("map data has a bad fingerprint index " + std::to_string(o));
     }
-    std::istringstream blob{std::string(r.bytes("fingerprint"))};
-    auto fingerprint = std::make_shared<Fingerprint>();
+    const std::string_view blob = r.bytes("fingerprint");
+    std::shared_ptr<Fingerprint> fingerprint;
     try {
-      *fingerprint = readFingerprint(blob);
+      fingerprint = std::make_shared<Fingerprint>(fingerprintFromBytes(blob));
     } catch (const std::exception& e) {
       throw std::runtime_error("map data has a malformed fingerprint of observation " + std::to_string(o) +
                                ": " + e.what());

@@ -67,6 +67,10 @@ def check_map_size(toposlam_bench):
         assert c["rss_mb"] > 0 and c["stored"] > 0, c
         assert 0 < c["comparisons_per_step"] <= c["stored"], c
     assert out["checkpoints"][-1]["index_mb"] > 0
+    # The map saved and loaded again at the end: every observation came back.
+    m = out["map_file"]
+    assert m["loaded_observations"] == 120 and m["megabytes"] > 0, m
+    assert all(m[k] >= 0 for k in ("snapshot_ms", "encode_ms", "encode_cpu_ms", "write_ms", "load_ms", "load_cpu_ms")), m
     print("map-size JSON OK")
 
 

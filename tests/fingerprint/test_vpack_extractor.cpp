@@ -85,6 +85,15 @@ TEST_CASE("GIVEN fingerprints WHEN serialised and read back THEN they are exactl
     writeFingerprint(buffer, f);
     CHECK(readFingerprint(buffer).equals(f));
   }
+  SECTION("in memory (a map's save and load): the same bytes as the stream's, read back equal") {
+    const Fingerprint f = VpackExtractor().extract(test::sampleFrame(5));
+    std::stringstream buffer;
+    writeFingerprint(buffer, f);
+    std::string bytes = "prefix";
+    appendFingerprintBytes(bytes, f);
+    CHECK(bytes == "prefix" + buffer.str());
+    CHECK(fingerprintFromBytes(std::string_view(bytes).substr(6)).equals(f));
+  }
 }
 
 TEST_CASE("GIVEN damaged fingerprint data WHEN read THEN a clear error names the problem") {
@@ -95,6 +104,7 @@ TEST_CASE("GIVEN damaged fingerprint data WHEN read THEN a clear error names the
   for (std::size_t cut : {std::size_t{2}, std::size_t{20}, bytes.size() / 2, bytes.size() - 1}) {
     std::istringstream truncated(bytes.substr(0, cut));
     CHECK_THROWS_WITH(readFingerprint(truncated), Catch::Contains("truncated"));
+    CHECK_THROWS_WITH(fingerprintFromBytes(std::string_view(bytes).substr(0, cut)), Catch::Contains("truncated"));
   }
   std::string bad_magic = bytes;
   bad_magic[0] = 'X';
@@ -108,6 +118,7 @@ TEST_CASE("GIVEN damaged fingerprint data WHEN read THEN a clear error names the
   huge_count[16] = '\x7f';
   std::istringstream garbage(huge_count);
   CHECK_THROWS_WITH(readFingerprint(garbage), Catch::Contains("corrupt"));
+  CHECK_THROWS_WITH(fingerprintFromBytes(huge_count), Catch::Contains("corrupt"));
 }
 
 TEST_CASE("GIVEN bad images WHEN fingerprinted THEN a clear error, no crash") {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -71,5 +72,10 @@ struct Fingerprint {
 /// read() throws std::runtime_error with a precise message on truncated or malformed data.
 void writeFingerprint(std::ostream& out, const Fingerprint& fingerprint);
 Fingerprint readFingerprint(std::istream& in);
+/// The same bytes as writeFingerprint, appended to `out` (no stream: what a map save writes per place).
+void appendFingerprintBytes(std::string& out, const Fingerprint& fingerprint);
+/// readFingerprint of the bytes at the start of `bytes` (no stream, no copy: what a map load reads per
+/// place); the same checks and messages. Bytes after the fingerprint are ignored.
+Fingerprint fingerprintFromBytes(std::string_view bytes);
 
 }  // namespace toposlam

@@ -39,6 +39,7 @@
 #include <random>
 #include <span>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -191,6 +192,8 @@ class FrozenTopologyState {
  public:
   /// The bytes TopologyParticleFilter::saveState wrote at the moment freeze() was called.
   void saveState(std::ostream& out) const;
+  /// The bytes saveState writes, appended to `out` (a map save builds its file in one buffer).
+  void appendState(std::string& out) const;
   int observationCount() const { return observation_count_; }
 
  private:
@@ -272,6 +275,9 @@ class TopologyParticleFilter {
   FrozenTopologyState freeze() const;
   /// Inverse of saveState; throws std::runtime_error on malformed data.
   static std::unique_ptr<TopologyParticleFilter> loadState(std::istream& in,
+                                                           const SimilarityMeasure& similarity);
+  /// loadState of bytes in memory (no copy of them: a map load reads the file's payload in place).
+  static std::unique_ptr<TopologyParticleFilter> loadState(std::string_view data,
                                                            const SimilarityMeasure& similarity);
 
  private:
