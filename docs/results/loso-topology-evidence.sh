@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Leave-one-set-out choice of the filter's sequence evidence weight (topology.sequence_evidence.weight,
 # `toposlam map --sequence-evidence W`): the topology's place revisits (closed right / wrong closures /
-# missed) on every real set as one stream (scripts/real-bench.sh: judged by the set's loop-closure truth)
+# missed) on every real set as one stream (scripts/real-bench.sh: judged by the set's loop-closure truth,
+# ie-tower's look-alike floors by its floor labels)
 # and every simulated world of scripts/sim-bench.sh (judged by the camera's pose), for each weight and
 # filter seeds 1-6. For each set the weight is chosen on all the OTHER sets: the most right closures less
 # COST times the wrong ones (a wrong closure costs more than a missed one; COST = 10), ties to the lower

@@ -497,9 +497,9 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(integer("topology.seed", AT(topology.seed), 1, 0, kMaxSeed, "",
                       "seed of the filter's random generator (runs replay bit for bit)"));
   // Sequence evidence (SequenceEvidenceConfig; docs/topology.md "Sequence evidence in the filter").
-  k.push_back(real("topology.sequence_evidence.weight", AT(sequence_evidence.weight), 0.8, 0, 1, "",
+  k.push_back(real("topology.sequence_evidence.weight", AT(sequence_evidence.weight), 0.0, 0, 1, "",
                    "likelihood of an earlier place every keyframe of a new place detects into (0 = off, the thesis; "
-                   "chosen leave-one-set-out, docs/results.md)"));
+                   "chosen leave-one-set-out: real look-alike floors close wrongly with it, docs/results.md)"));
   k.push_back(flag("topology.sequence_evidence.frame_revisits", AT(sequence_evidence.frame_revisits), true,
                    "run the sequence detector for every frame and publish its answer in place_t (match_frame, "
                    "match_node: the node the robot is back in); the thesis preset has it off"));

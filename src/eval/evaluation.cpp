@@ -217,6 +217,10 @@ EvalResult evaluate(const RunData& run, const Truth& truth, const EvalOptions& o
     LoopClosureTruth lct;
     if (truth.kind == Truth::Kind::Labels) {
       lct = truthFromRooms(rooms, result.min_gap);
+      // By room labels (judged by pose instead below when the labels carry poses).
+      std::vector<PlaceSpan> spans;
+      for (const auto& p : run.places) spans.push_back(PlaceSpan{p.first, p.last, static_cast<int>(p.node)});
+      result.place_revisits = scorePlaceRevisits(spans, rooms);
     } else {
       const LoopClosureMatrix m =
           truth.kind == Truth::Kind::Matrix ? truth.matrix : matrixFromPairs(truth, run);
@@ -437,7 +441,7 @@ void writeEvalJson(std::ostream& out, const EvalResult& r) {
         .field("missed", v.missed)
         .field("merged_with_previous", v.merged_with_previous)
         .field("wrong_closures", v.wrong_closures)
-        .field("judged_by", v.by_pose ? "pose" : "loop-closure truth");
+        .field("judged_by", v.by_pose ? "pose" : v.by_rooms ? "room labels" : "loop-closure truth");
     if (v.by_pose) json.field("radius_m", v.radius_m).field("max_heading_rad", v.max_heading_rad);
     json.field("min_overlap", v.min_overlap);
     json.endObject();
@@ -574,7 +578,8 @@ std::vector<Table> tables(const EvalResult& r) {
     const std::string within =
         v.by_pose ? " of its frames from within " + fmt("%.1f m", v.radius_m) + " and " +
                         fmt("%.0f deg", v.max_heading_rad * 180.0 / 3.14159265358979323846) + ")"
-                  : " of its frames, by the loop-closure ground truth)";
+                  : v.by_rooms ? " of its frames, by room labels: a frame shows its whole room)"
+                               : " of its frames, by the loop-closure ground truth)";
     Table t{std::string(v.by_pose ? "Place revisits by pose" : "Place revisits") +
                 " (a place revisits the earlier places that saw at least " + fmt("%.0f%%", 100.0 * v.min_overlap) +
                 within,

@@ -453,6 +453,18 @@ PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const
   return score;
 }
 
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<int>& rooms,
+                                     double min_overlap) {
+  const auto known = [](std::int64_t) { return true; };
+  const auto room = [&](std::int64_t f) { return rooms[static_cast<std::size_t>(f)]; };
+  const auto shows = [&](std::int64_t f, std::int64_t g) { return room(f) >= 0 && room(f) == room(g); };
+  PlaceRevisitScore score =
+      countPlaceRevisits(places, static_cast<std::int64_t>(rooms.size()), min_overlap, known, shows);
+  score.by_pose = false;
+  score.by_rooms = true;
+  return score;
+}
+
 int majority(const std::vector<int>& values) {
   std::map<int, int> counts;
   for (int v : values) {

@@ -241,7 +241,7 @@ SCENARIO("GIVEN preset: thesis WHEN the config is read THEN every stage takes th
   CHECK(d.sequence_evidence.memory_s == 40.0);
   CHECK(d.sequence_evidence.loop.scales == 3);
   CHECK(d.sequence_evidence.min_score == 2.0);
-  CHECK(d.sequence_evidence.weight == 0.8);  // the evidence in the filter (docs/results.md)
+  CHECK(d.sequence_evidence.weight == 0.0);  // no evidence in the filter by default (docs/results.md)
   CHECK(d.preset == "default");
   CHECK(d.topology.likelihood == LikelihoodModel::Relative);
   CHECK(d.segmentation.window_s == 6.0);

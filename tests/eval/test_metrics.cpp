@@ -310,6 +310,35 @@ SCENARIO("GIVEN a real set's loop-closure truth WHEN revisits are scored by it T
   CHECK_THROWS_AS(scorePlaceRevisits({PlaceSpan{0, 60, 0}}, m), std::invalid_argument);
 }
 
+SCENARIO("GIVEN room labels only WHEN revisits are scored by them THEN a place on another room's node is a wrong "
+         "closure") {
+  // Four places of 10 frames: rooms 0, 1, then 0 again, then 2 (a floor never seen before).
+  const std::vector<int> rooms = [] {
+    std::vector<int> r;
+    for (int room : {0, 1, 0, 2})
+      for (int i = 0; i < 10; ++i) r.push_back(room);
+    return r;
+  }();
+  const auto places = [](std::vector<int> nodes) {
+    std::vector<PlaceSpan> spans;
+    for (int p = 0; p < 4; ++p) spans.push_back(PlaceSpan{10 * p, 10 * p + 9, nodes[static_cast<std::size_t>(p)]});
+    return spans;
+  };
+  const PlaceRevisitScore right = scorePlaceRevisits(places({0, 1, 0, 2}), rooms);
+  CHECK(right.by_pose == false);
+  CHECK(right.by_rooms == true);
+  CHECK(right.revisits == 1);
+  CHECK(right.closed_right == 1);
+  CHECK(right.wrong_closures == 0);
+  const PlaceRevisitScore merged_floors = scorePlaceRevisits(places({0, 1, 2, 0}), rooms);
+  CHECK(merged_floors.missed == 1);          // place 2 back in room 0 on a new node
+  CHECK(merged_floors.wrong_closures == 1);  // place 3 (room 2) on place 0's node (room 0)
+  // Unknown labels show nothing: no revisit, and a reused node is a wrong closure.
+  const PlaceRevisitScore unknown = scorePlaceRevisits(places({0, 1, 0, 2}), std::vector<int>(40, -1));
+  CHECK(unknown.revisits == 0);
+  CHECK(unknown.wrong_closures == 1);
+}
+
 SCENARIO("GIVEN published frame matches WHEN they are judged by pose THEN near matches facing alike are right") {
   std::vector<GroundPose> poses;
   for (int i = 0; i < 10; ++i) poses.push_back(GroundPose{1.0 * i, 0.0, 0.0});

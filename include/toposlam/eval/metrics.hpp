@@ -192,7 +192,8 @@ struct PlaceRevisitScore {
   int merged_with_previous = 0;  ///< revisits left on the previous place's node, which they do not revisit
   int wrong_closures = 0;      ///< places on an earlier node (not the previous place's) none of whose places they revisit
   double radius_m = 0, max_heading_rad = 0, min_overlap = 0;
-  bool by_pose = true;  ///< false: judged by a loop-closure matrix (radius and heading unused)
+  bool by_pose = true;    ///< false: judged by a loop-closure matrix or room labels (radius and heading unused)
+  bool by_rooms = false;  ///< judged by room labels: a frame shows what every frame of its room shows
 };
 
 /// place spans in time order; poses[f] for every frame (NaN: unknown, never covers nor counts).
@@ -215,6 +216,12 @@ FrameMatchPoseScore scoreFrameMatchesByPose(const std::vector<std::int64_t>& mat
 /// The same counts judged by a loop-closure matrix (a real set's ground truth): place j covers a frame f of
 /// place k when one of j's frames shows the same place as f (same.at(f, g)). same.size = the run's frames.
 PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const LoopClosureMatrix& same,
+                                     double min_overlap = 0.3);
+
+/// The same counts judged by room labels (rooms[f] for every frame, -1: unknown, shows nothing): frames of
+/// one room show the same place. Room labels cannot tell a room's other corner from a revisit, so with rooms
+/// as large as a building's floor only the wrong closures (to a place of another room) are sharp.
+PlaceRevisitScore scorePlaceRevisits(const std::vector<PlaceSpan>& places, const std::vector<int>& rooms,
                                      double min_overlap = 0.3);
 
 /// The most frequent value >= 0 among values (smallest on ties), -1 when none.
