@@ -5,7 +5,7 @@
 # match columns = place_t.match_*; docs/topology.md "The per-frame answer"): `toposlam map` with the default
 # preset, then `toposlam eval` against gt.csv. Fails when the recall at 100 % precision falls below 0.85
 # (measured 0.892, 99 of 111) or when any published match is wrong (measured 0 of 99).
-# Then the place level (the topology): with the defaults (the filter's sequence evidence at weight 0.8,
+# Then the place level (the topology): with the defaults (the filter's sequence evidence off, weight 0,
 # chosen leave-one-set-out, docs/results.md) no query place closes onto a reference place; at weight 0.9
 # (--sequence-evidence 0.9, docs/topology.md) at least two query places close, every one of them onto a
 # reference place holding most of its frames' true matches (measured: 3 of 4 query places, 0 wrong).
