@@ -44,9 +44,10 @@ if [ "${CI:-}" = "true" ] || [ "${TOPOSLAM_SANITIZERS:-0}" = "1" ]; then
     scripts/build.sh "$root/build-tsan" -DTOPOSLAM_SANITIZE=thread -DTOPOSLAM_WERROR=ON "${sanitizer_flags[@]}"
   # Tests of the targets not built here are registered as *_NOT_BUILT (Catch2's discovery) or are plain
   # add_test() commands of unbuilt executables or files (fuzz corpus replays, the firmware C encoder, the
-  # Python reader's unit test, which needs the generated Python package): leave them out.
+  # Python reader's unit test, which needs the generated Python package, the LCM fragment listener's
+  # loopback test, whose binary is not built here): leave them out.
   TSAN_OPTIONS=halt_on_error=1 ctest --test-dir "$root/build-tsan" --output-on-failure -j "$jobs" \
-    -E "_NOT_BUILT|^fuzz_replay_|^firmware-host-wheel-link-encoder$|^test_platform_udpm_reader$" \
+    -E "_NOT_BUILT|^fuzz_replay_|^firmware-host-wheel-link-encoder$|^test_platform_udpm_reader$|^lcm_fragment_monitor_loopback$" \
     -LE "slow|vm|browser|e2e|cli" ${CTEST_ARGS:-}
 
   stage "libFuzzer targets, ${FUZZ_SECONDS:-20} s each (scripts/fuzz.sh; tests/fuzz/)"
