@@ -34,8 +34,9 @@ FiedlerSegmentationStage::FiedlerSegmentationStage(const FiedlerSegmenterConfig&
                                                    std::size_t max_thumbnails, const MotionGateConfig& motion,
                                                    const SequenceEvidenceConfig& evidence)
     : similarity_(similarity),
-      segmenter_(std::in_place, config, similarity),
-      evidence_(evidence.weight > 0.0 || evidence.frame_revisits ? std::make_unique<PlaceSequenceEvidence>(evidence, similarity)
+      memo_(similarity),
+      segmenter_(std::in_place, config, memo_),
+      evidence_(evidence.weight > 0.0 || evidence.frame_revisits ? std::make_unique<PlaceSequenceEvidence>(evidence, memo_)
                                                                   : nullptr),
       evidence_to_filter_(evidence.weight > 0.0),
       max_thumbnails_(std::max<std::size_t>(1, max_thumbnails)),
@@ -128,8 +129,17 @@ SegmentationStep FiedlerSegmentationStage::process(std::int64_t sequence, double
                  "from the frame before ({} such steps so far)",
                  sequence, timeline_.lastStepBackS(), source_time_s, steps_back + 1);
   FrameRevisit revisit;
-  if (evidence_) revisit = evidence_->addFrame(sequence, time_s, fingerprint);
-  SegmenterStep step = segmenter_->addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
+  SegmenterStep step;
+  {
+    // The detector and the segmenter compare this frame with the same earlier ones: once each.
+    struct FrameScope {
+      FrameSimilarityMemo& memo;
+      ~FrameScope() { memo.endFrame(); }
+    } scope{memo_};
+    memo_.beginFrame(fingerprint.get());
+    if (evidence_) revisit = evidence_->addFrame(sequence, time_s, fingerprint);
+    step = segmenter_->addFrame(sequence, time_s, std::move(fingerprint), last_motion_);
+  }
   if (motion_counters_ != nullptr) {
     motion_counters_->use.store(static_cast<int>(motionUse()));
     motion_counters_->standing_frames.store(skippedFrames());
@@ -156,7 +166,7 @@ void FiedlerSegmentationStage::beginTraversal() {
   dropped_before_ = dropped_places_;
   skipped_before_ += segmenter_->skippedFrames();
   const FiedlerSegmenterConfig config = segmenter_->config();  // a copy: emplace() destroys the old one first
-  segmenter_.emplace(config, similarity_);
+  segmenter_.emplace(config, memo_);
   timeline_ = FrameTimeline{};
   if (evidence_) evidence_->beginTraversal();
   thumbnails_.clear();

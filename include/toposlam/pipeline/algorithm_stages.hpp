@@ -16,6 +16,7 @@
 
 #include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
+#include "toposlam/matching/frame_similarity_memo.hpp"
 #include "toposlam/pipeline/clock.hpp"
 #include "toposlam/pipeline/stages.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
@@ -154,6 +155,8 @@ class FiedlerSegmentationStage final : public SegmentationStage {
   void warnOfRefusals(const MotionRefusals& before) const;
 
   const SimilarityMeasure& similarity_;
+  /// What the segmenter and the sequence detector compare with: each pair of the newest frame computed once.
+  FrameSimilarityMemo memo_;
   std::optional<FiedlerSegmenter> segmenter_;        ///< always set; a fresh one per traversal
   std::unique_ptr<PlaceSequenceEvidence> evidence_;  ///< null: no sequence detector
   bool evidence_to_filter_ = false;                  ///< closed places carry its evidence (weight > 0)
