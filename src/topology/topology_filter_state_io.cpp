@@ -125,9 +125,12 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
   return loadState(std::string_view(data), similarity);
 }
 
-std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
-    std::string_view data, const SimilarityMeasure& similarity) {
-  BinaryReader r(data);
+namespace {
+
+// loadState's steps, in the order of the bytes. Each throws std::runtime_error naming what is malformed.
+
+/// The config fields written first (the likelihood model's come in the extension blocks).
+TopologyFilterConfig readConfig(BinaryReader& r) {
   TopologyFilterConfig config;
   config.particles = r.i32("config");
   config.alpha = r.f64("config");
@@ -141,30 +144,18 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
   if (const std::string problem = config.validate(); !problem.empty()) {
     throw std::runtime_error("map data has an invalid filter config: " + problem);
   }
-  auto filter = std::make_unique<TopologyParticleFilter>(config, similarity);
-  {
-    std::istringstream rng_text{std::string(r.bytes("random generator state"))};
-    rng_text >> filter->rng_;
-    if (rng_text.fail()) throw std::runtime_error("map data has a malformed random generator state");
-  }
-  const std::int32_t observations = r.i32("observation count");
-  // Every observation has a history record (12 bytes) on each particle's lineage: bound the count by the
-  // bytes left before allocating anything for it.
-  if (observations < 0 || static_cast<std::uint64_t>(observations) > r.remaining() / 12) {
-    throw std::runtime_error("map data has an impossible observation count " + std::to_string(observations));
-  }
-  filter->observation_count_ = observations;
-  filter->stamp_ = static_cast<std::uint64_t>(observations);
-  filter->last_ess_ = r.f64("effective sample size");
-  filter->degenerate_steps_ = r.i64("degenerate steps");
+  return config;
+}
 
+/// The stored representatives, by observation (null: dropped).
+std::vector<std::shared_ptr<const Fingerprint>> readFingerprints(BinaryReader& r, std::int32_t observations) {
   const std::uint32_t alive = r.u32("fingerprint count");
   if (alive > static_cast<std::uint32_t>(observations))
     throw std::runtime_error("map data has more fingerprints than observations");
-  filter->fingerprints_.assign(idx(observations), nullptr);
+  std::vector<std::shared_ptr<const Fingerprint>> fingerprints(idx(observations), nullptr);
   for (std::uint32_t k = 0; k < alive; ++k) {
     const std::int32_t o = r.i32("fingerprint index");
-    if (o < 0 || o >= observations || filter->fingerprints_[idx(o)]) {
+    if (o < 0 || o >= observations || fingerprints[idx(o)]) {
       throw std::runtime_error("map data has a bad fingerprint index " + std::to_string(o));
     }
     const std::string_view blob = r.bytes("fingerprint");
@@ -179,18 +170,24 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
       throw std::runtime_error("map data has an invalid fingerprint of observation " + std::to_string(o) +
                                ": " + problem);
     }
-    filter->fingerprints_[idx(o)] = std::move(fingerprint);
+    fingerprints[idx(o)] = std::move(fingerprint);
   }
+  return fingerprints;
+}
 
+/// One history record as written: parent record index (-1 for the first observation), observation, node.
+struct SavedRecord {
+  std::int32_t parent, observation, node;
+};
+
+/// The history records, parents before children; `children` counts each record's children.
+std::vector<SavedRecord> readHistory(BinaryReader& r, std::int32_t observations, std::vector<std::int32_t>& children) {
   const std::uint32_t record_count = r.u32("history record count");
   if (record_count > r.remaining() / 12) throw std::runtime_error("map data truncated in history records");
-  struct Rec {
-    std::int32_t parent, observation, node;
-  };
-  std::vector<Rec> recs(record_count);
-  std::vector<std::int32_t> remaining_children(record_count, 0);
+  std::vector<SavedRecord> recs(record_count);
+  children.assign(record_count, 0);
   for (std::uint32_t i = 0; i < record_count; ++i) {
-    Rec& rec = recs[i];
+    SavedRecord& rec = recs[i];
     rec.parent = r.i32("history record");
     rec.observation = r.i32("history record");
     rec.node = r.i32("history record");
@@ -200,15 +197,23 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     if (!(root_ok || child_ok) || rec.observation >= observations) {
       throw std::runtime_error("map data has an inconsistent history record " + std::to_string(i));
     }
-    if (rec.parent >= 0) ++remaining_children[idx(rec.parent)];
+    if (rec.parent >= 0) ++children[idx(rec.parent)];
   }
+  return recs;
+}
+
+/// Each particle's last history record (-1 before the first observation); `is_tip` marks those records.
+std::vector<std::int32_t> readParticleTips(BinaryReader& r, const TopologyFilterConfig& config,
+                                           std::int32_t observations, const std::vector<SavedRecord>& recs,
+                                           std::vector<unsigned char>& is_tip) {
   const std::uint32_t particle_count = r.u32("particle count");
   if (particle_count != static_cast<std::uint32_t>(config.particles)) {
     throw std::runtime_error("map data has " + std::to_string(particle_count) + " particles, config says " +
                              std::to_string(config.particles));
   }
+  const auto record_count = static_cast<std::uint32_t>(recs.size());
   std::vector<std::int32_t> tips(particle_count);
-  std::vector<unsigned char> is_tip(record_count, 0);
+  is_tip.assign(record_count, 0);
   for (auto& t : tips) {
     t = r.i32("particles");
     const bool ok = observations == 0 ? t == -1
@@ -217,6 +222,11 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     if (!ok) throw std::runtime_error("map data has a particle pointing at a bad history record");
     if (t >= 0) is_tip[idx(t)] = 1;
   }
+  return tips;
+}
+
+/// The extension blocks after the particles (each absent in maps written before it) into `config`.
+void readConfigExtensions(BinaryReader& r, TopologyFilterConfig& config) {
   if (!r.atEnd()) {
     const std::uint8_t model = r.u8("likelihood model");
     if (model > static_cast<std::uint8_t>(LikelihoodModel::Relative))
@@ -233,13 +243,18 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
     config.likelihood = LikelihoodModel::Absolute;  // written before the likelihood model existed
   }
   if (!r.atEnd()) throw std::runtime_error("map data has trailing bytes after the particles");
-  filter->config_ = config;  // the likelihood model came after the filter was made
+}
 
-  // Rebuild the shared states by replaying the record tree (extendState is what the filter ran).
-  std::vector<std::shared_ptr<const TopologyState>> states(record_count);
+/// The shared states at the particles' tips, rebuilt by replaying the record tree (extendState is what the
+/// filter ran). A state is let go as soon as its last child is made, unless a particle holds it.
+std::vector<std::shared_ptr<const TopologyState>> replayHistory(const std::vector<SavedRecord>& recs,
+                                                                std::vector<std::int32_t>& remaining_children,
+                                                                const std::vector<unsigned char>& is_tip,
+                                                                const TopologyFilterConfig& config) {
+  std::vector<std::shared_ptr<const TopologyState>> states(recs.size());
   const auto empty = std::make_shared<const TopologyState>();
-  for (std::uint32_t i = 0; i < record_count; ++i) {
-    const Rec& rec = recs[i];
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const SavedRecord& rec = recs[i];
     const TopologyState& parent = rec.parent < 0 ? *empty : *states[idx(rec.parent)];
     if (rec.node < 0 || rec.node > parent.nodeCount()) {
       throw std::runtime_error("map data assigns observation " + std::to_string(rec.observation) +
@@ -251,7 +266,44 @@ std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
       states[idx(rec.parent)].reset();
     }
   }
-  for (std::uint32_t p = 0; p < particle_count; ++p) {
+  return states;
+}
+
+}  // namespace
+
+std::unique_ptr<TopologyParticleFilter> TopologyParticleFilter::loadState(
+    std::string_view data, const SimilarityMeasure& similarity) {
+  BinaryReader r(data);
+  TopologyFilterConfig config = readConfig(r);
+  auto filter = std::make_unique<TopologyParticleFilter>(config, similarity);
+  {
+    std::istringstream rng_text{std::string(r.bytes("random generator state"))};
+    rng_text >> filter->rng_;
+    if (rng_text.fail()) throw std::runtime_error("map data has a malformed random generator state");
+  }
+  const std::int32_t observations = r.i32("observation count");
+  // Every observation has a history record (12 bytes) on each particle's lineage: bound the count by the
+  // bytes left before allocating anything for it.
+  if (observations < 0 || static_cast<std::uint64_t>(observations) > r.remaining() / 12) {
+    throw std::runtime_error("map data has an impossible observation count " + std::to_string(observations));
+  }
+  filter->observation_count_ = observations;
+  filter->stamp_ = static_cast<std::uint64_t>(observations);
+  filter->last_ess_ = r.f64("effective sample size");
+  filter->degenerate_steps_ = r.i64("degenerate steps");
+  filter->fingerprints_ = readFingerprints(r, observations);
+
+  std::vector<std::int32_t> remaining_children;
+  const std::vector<SavedRecord> recs = readHistory(r, observations, remaining_children);
+  std::vector<unsigned char> is_tip;
+  const std::vector<std::int32_t> tips = readParticleTips(r, config, observations, recs, is_tip);
+  readConfigExtensions(r, config);
+  filter->config_ = config;  // the likelihood model came after the filter was made
+
+  const std::vector<std::shared_ptr<const TopologyState>> states =
+      replayHistory(recs, remaining_children, is_tip, config);
+  const auto empty = std::make_shared<const TopologyState>();
+  for (std::size_t p = 0; p < tips.size(); ++p) {
     filter->particles_[p] = tips[p] < 0 ? empty : states[idx(tips[p])];
   }
   // Every representative a particle refers to must have come with the file.
