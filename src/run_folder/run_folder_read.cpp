@@ -1,6 +1,7 @@
 // The run folder's readers (see run_folder.hpp). All errors name file and line.
 #include "toposlam/run_folder/run_folder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -335,10 +336,12 @@ RunData loadRun(const std::string& dir) {
   }
   run.frames = loadFrames((root / run_files::kFrames).string());
   {
-    std::ifstream header((root / run_files::kFrames).string());
-    std::string line;
-    std::getline(header, line);
-    run.has_frame_matches = (',' + line + ',').find(",match,") != std::string::npos;
+    // The header alone (loadFrames read and checked the whole file).
+    std::ifstream in((root / run_files::kFrames).string());
+    CsvReader reader(in);
+    CsvRecord header;
+    run.has_frame_matches = reader.next(header) && std::find(header.fields.begin(), header.fields.end(),
+                                                             "match") != header.fields.end();
   }
   const auto frame_count = static_cast<std::int64_t>(run.frames.size());
   // Places must lie inside frames.csv (loadPlaces already checked 0 <= first <= representative <= last).
