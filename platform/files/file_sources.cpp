@@ -16,6 +16,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "toposlam/core/csv.hpp"
 #include "toposlam/core/natural_order.hpp"
 #include "toposlam/io/image_file.hpp"
 
@@ -132,18 +133,18 @@ ImageFilesSource::ImageFilesSource(const std::string& path_or_glob, double times
   if (!rate_given_ && !files_.empty()) {
     const fs::path table = fs::path(files_.front()).parent_path() / "timestamps.csv";
     std::ifstream in(table);
-    std::string line;
-    if (in && std::getline(in, line)) {
+    CsvReader reader(in);
+    CsvRecord record;
+    if (in && reader.next(record)) {  // the header
       std::map<std::string, double> time_of;
-      int line_number = 1;
-      while (std::getline(in, line)) {
-        ++line_number;
-        const auto comma = line.rfind(',');
+      while (reader.next(record)) {
+        const std::vector<std::string>& fields = record.fields;
         char* end = nullptr;
-        const double t = comma == std::string::npos ? 0.0 : std::strtod(line.c_str() + comma + 1, &end);
-        if (comma == std::string::npos || end == line.c_str() + comma + 1 || !std::isfinite(t))
-          throw FrameSourceError(table.string() + ":" + std::to_string(line_number) + ": expected name,time_s");
-        time_of[line.substr(0, comma)] = t;
+        const double t = fields.size() == 2 ? std::strtod(fields[1].c_str(), &end) : 0.0;
+        if (!record.problem.empty() || fields.size() != 2 || end == fields[1].c_str() || !std::isfinite(t))
+          throw FrameSourceError(table.string() + ":" + std::to_string(record.line) + ": expected name,time_s" +
+                                 (record.problem.empty() ? std::string() : " (" + record.problem + ")"));
+        time_of[fields[0]] = t;
       }
       for (const std::string& file : files_) {
         const auto it = time_of.find(fs::path(file).filename().string());

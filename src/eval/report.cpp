@@ -399,12 +399,12 @@ std::map<std::string, std::string> renderReportFigures(const ReportInputs& in) {
   return figures;
 }
 
-std::string renderReportHtml(const ReportInputs& in) {
-  const RunData& run = in.run;
-  const bool by_node = hasNodes(run);
-  const std::size_t n = run.frames.size();
-  std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << escapeMarkup(in.title)
+namespace {
+
+// The page's sections, in order. Each writes its markup to `html`.
+
+void writeHead(std::ostream& html, const std::string& title) {
+  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << escapeMarkup(title)
        << "</title>\n<style>\n"
           "body{font-family:sans-serif;margin:20px;max-width:1200px;color:#222}\n"
           "h2{border-bottom:1px solid #ccc;padding-bottom:4px;margin-top:32px}\n"
@@ -421,40 +421,48 @@ std::string renderReportHtml(const ReportInputs& in) {
           "table.eval td,table.eval th{border:1px solid #ccc;padding:3px 10px;text-align:right}\n"
           ".note{color:#a33}\n.legend span{display:inline-block;width:12px;height:12px;margin:0 4px 0 12px}\n"
           "</style></head><body>\n";
-  html << "<h1>" << escapeMarkup(in.title) << "</h1>\n";
-  {
-    // What the run was made from and with, and what made this page.
-    html << "<table class=\"eval\"><caption>Run</caption>\n";
-    const auto row = [&](const std::string& key, const std::string& value) {
-      html << "<tr><th style=\"text-align:left\">" << escapeMarkup(key) << "</th><td style=\"text-align:left\">"
-           << escapeMarkup(value) << "</td></tr>\n";
-    };
-    for (std::size_t k = 0; k < run.sources.size(); ++k)
-      row(run.sources.size() == 1 ? "source" : "source " + std::to_string(k + 1), run.sources[k]);
-    if (run.sources.empty()) row("source", "not recorded (no source.txt in the run folder)");
-    for (const auto& [key, value] : run.settings) row(key == "toposlam" ? "made by toposlam" : key, value);
-    if (run.settings.empty()) row("settings", "not recorded (no settings.txt: a run of `segment` or an older `map`)");
-    if (!in.generator.empty()) row("report by", in.generator);
-    if (!in.generated.empty()) row("report made", in.generated);
-    html << "</table>\n";
-  }
+  html << "<h1>" << escapeMarkup(title) << "</h1>\n";
+}
+
+/// What the run was made from and with, and what made this page.
+void writeRunTable(std::ostream& html, const ReportInputs& in) {
+  const RunData& run = in.run;
+  html << "<table class=\"eval\"><caption>Run</caption>\n";
+  const auto row = [&](const std::string& key, const std::string& value) {
+    html << "<tr><th style=\"text-align:left\">" << escapeMarkup(key) << "</th><td style=\"text-align:left\">"
+         << escapeMarkup(value) << "</td></tr>\n";
+  };
+  for (std::size_t k = 0; k < run.sources.size(); ++k)
+    row(run.sources.size() == 1 ? "source" : "source " + std::to_string(k + 1), run.sources[k]);
+  if (run.sources.empty()) row("source", "not recorded (no source.txt in the run folder)");
+  for (const auto& [key, value] : run.settings) row(key == "toposlam" ? "made by toposlam" : key, value);
+  if (run.settings.empty()) row("settings", "not recorded (no settings.txt: a run of `segment` or an older `map`)");
+  if (!in.generator.empty()) row("report by", in.generator);
+  if (!in.generated.empty()) row("report made", in.generated);
+  html << "</table>\n";
+}
+
+/// Counts of frames, places and nodes, and the warnings of the inputs.
+void writeSummary(std::ostream& html, const ReportInputs& in) {
+  const RunData& run = in.run;
   int nodes = 0;
   double best_p = std::nan("");
   if (run.topology) {
     nodes = static_cast<int>(run.topology->nodes.size());
     best_p = run.topology->probability;
   }
-  html << "<p>" << n << " frames, " << run.places.size() << " places (" << run.dropped_places.size()
+  html << "<p>" << run.frames.size() << " frames, " << run.places.size() << " places (" << run.dropped_places.size()
        << " dropped)";
   if (run.topology)
     html << ", " << nodes << " nodes in the most probable topology (p = " << num(best_p, 3) << ")";
   html << ". Run folder <code>" << escapeMarkup(run.dir) << "</code>.</p>\n";
   for (const auto& w : in.warnings) html << "<p class=\"note\">" << escapeMarkup(w) << "</p>\n";
+}
 
-  // 1. strip
+/// Section 1's strips: frames coloured by node (or place), and by true room when known, with its legend.
+void writeStrips(std::ostream& html, const ReportInputs& in, const std::vector<int>& colour, bool by_node) {
+  const std::size_t n = in.run.frames.size();
   html << "<h2>Frames coloured by " << (by_node ? "node" : "place") << "</h2>\n";
-  std::vector<int> colour(n);
-  for (std::size_t f = 0; f < n; ++f) colour[f] = frameColourIndex(run, f, by_node);
   html << "<div>" << stripSvg(colour, by_node ? "node" : "place", 1160) << "</div>\n";
   if (in.rooms.size() == n && n > 0) {
     html << "<div>" << stripSvg(in.rooms, "true room", 1160) << "</div>\n";
@@ -465,174 +473,192 @@ std::string renderReportHtml(const ReportInputs& in) {
     html << "<p>Colours of the two strips are independent (node ids and room ids are different numbers); "
             "grey = no place / doorway. Which node stands for which room: the table below.</p>\n";
   }
-  {
-    // Legend: every node (or place) colour, with the room most of its frames are in when rooms are known.
-    std::map<int, std::map<int, int>> rooms_of;  // colour index -> room -> frames
-    for (std::size_t f = 0; f < n; ++f) {
-      if (colour[f] < 0) continue;
-      rooms_of[colour[f]][in.rooms.size() == n ? in.rooms[f] : -2] += 1;
-    }
-    html << "<p class=\"legend\">";
-    for (const auto& [index, rooms] : rooms_of) {
-      int best_room = -2, best = 0, total = 0;
-      for (const auto& [room, count] : rooms) {
-        total += count;
-        if (room >= 0 && count > best) best = count, best_room = room;
-      }
-      html << "<span style=\"background:" << indexColour(index) << "\"></span>" << (by_node ? "node " : "place ")
-           << index;
-      if (best_room >= 0) html << " (room " << best_room << ", " << num(100.0 * best / total, 0) << " %)";
-    }
-    html << "</p>\n";
-    if (by_node && in.rooms.size() == n && n > 0) {
-      // Confusion matrix: frames of each node in each room.
-      std::set<int> room_ids;
-      for (int r : in.rooms) room_ids.insert(r);
-      html << "<table class=\"eval\"><caption>Frames per node (rows) and true room (columns; -1 = doorway); "
-              "the largest cell of each row in bold</caption>\n<tr><th>node</th>";
-      for (int r : room_ids) html << "<th>" << r << "</th>";
-      html << "</tr>\n";
-      for (const auto& [node, rooms] : rooms_of) {
-        int best = 0;
-        for (const auto& [room, count] : rooms)
-          if (room >= 0) best = std::max(best, count);
-        html << "<tr><th><span style=\"display:inline-block;width:10px;height:10px;background:" << indexColour(node)
-             << "\"></span> " << node << "</th>";
-        for (int r : room_ids) {
-          const auto it = rooms.find(r);
-          const int count = it == rooms.end() ? 0 : it->second;
-          html << "<td>" << (count > 0 && count == best && r >= 0 ? "<b>" : "") << (count > 0 ? std::to_string(count) : "")
-               << (count > 0 && count == best && r >= 0 ? "</b>" : "") << "</td>";
-        }
-        html << "</tr>\n";
-      }
-      html << "</table>\n";
-    }
-  }
-  {
-    std::vector<std::int64_t> strip_frames;
-    const std::int64_t step = std::max<std::int64_t>(1, (static_cast<std::int64_t>(n) + 95) / 96);
-    for (std::int64_t f = 0; f < static_cast<std::int64_t>(n); f += step) strip_frames.push_back(f);
-    bool any = false;
-    std::ostringstream grid;
-    grid << "<div class=\"thumbs\">\n";
-    for (std::int64_t f : strip_frames) {
-      const auto fi = static_cast<std::size_t>(f);
-      if (fi >= in.thumbnails.size() || in.thumbnails[fi].empty()) continue;
-      any = true;
-      const int c = colour[fi];
-      grid << "<figure style=\"border-color:" << indexColour(c) << "\"><img src=\"" << in.thumbnails[fi]
-           << "\" alt=\"frame " << f << "\"><figcaption>" << f << (by_node ? " · n" : " · p") << c
-           << "</figcaption></figure>\n";
-    }
-    grid << "</div>\n";
-    if (any) {
-      html << "<p>Every " << step << (step == 1 ? "st" : "th") << " frame; the border is the frame's "
-           << (by_node ? "node" : "place") << " colour.</p>\n"
-           << grid.str();
-    }
-  }
+}
 
-  // 2. lambda2
-  html << "<h2>Fiedler value lambda2 over time with the place cuts (thesis Figure 4.10)</h2>\n";
-  html << "<div>" << inlineSvg(lambda2Plot(in)) << "</div>\n";
-  if (!run.places.empty()) {
-    html << "<h2>Places and their representatives</h2>\n<table class=\"eval\"><tr><th>place</th><th>frames</th>"
-            "<th>representative</th><th>node</th><th>ended by</th>"
-         << (in.rooms.size() == n ? "<th>true room (share of its frames)</th>" : "") << "</tr>\n";
-    for (const auto& p : run.places) {
-      html << "<tr><td>" << p.place << "</td><td>" << p.first << "-" << p.last << "</td><td>";
-      const auto rep = static_cast<std::size_t>(p.representative);
-      if (rep < in.thumbnails.size() && !in.thumbnails[rep].empty())
-        html << "<img src=\"" << in.thumbnails[rep] << "\" alt=\"frame " << p.representative
-             << "\" style=\"width:96px;height:72px;object-fit:cover;vertical-align:middle\"> ";
-      html << p.representative << "</td><td>" << (p.node >= 0 ? std::to_string(p.node) : "-") << "</td><td>"
-           << (p.end.empty() ? std::string("-") : escapeMarkup(p.end)) << "</td>";
-      if (in.rooms.size() == n) {
-        const std::vector<int> rooms(in.rooms.begin() + p.first, in.rooms.begin() + p.last + 1);
-        const int room = majority(rooms);
-        const auto share = static_cast<double>(std::count(rooms.begin(), rooms.end(), room)) / rooms.size();
-        html << "<td>" << (room >= 0 ? std::to_string(room) + " (" + num(100.0 * share, 0) + " %)" : std::string("-"))
-             << "</td>";
+/// Section 1's legend: every node (or place) colour, with the room most of its frames are in when rooms
+/// are known, and then the frames per node and room.
+void writeColourLegend(std::ostream& html, const ReportInputs& in, const std::vector<int>& colour, bool by_node) {
+  const std::size_t n = in.run.frames.size();
+  std::map<int, std::map<int, int>> rooms_of;  // colour index -> room -> frames
+  for (std::size_t f = 0; f < n; ++f) {
+    if (colour[f] < 0) continue;
+    rooms_of[colour[f]][in.rooms.size() == n ? in.rooms[f] : -2] += 1;
+  }
+  html << "<p class=\"legend\">";
+  for (const auto& [index, rooms] : rooms_of) {
+    int best_room = -2, best = 0, total = 0;
+    for (const auto& [room, count] : rooms) {
+      total += count;
+      if (room >= 0 && count > best) best = count, best_room = room;
+    }
+    html << "<span style=\"background:" << indexColour(index) << "\"></span>" << (by_node ? "node " : "place ")
+         << index;
+    if (best_room >= 0) html << " (room " << best_room << ", " << num(100.0 * best / total, 0) << " %)";
+  }
+  html << "</p>\n";
+  if (by_node && in.rooms.size() == n && n > 0) {
+    // Confusion matrix: frames of each node in each room.
+    std::set<int> room_ids;
+    for (int r : in.rooms) room_ids.insert(r);
+    html << "<table class=\"eval\"><caption>Frames per node (rows) and true room (columns; -1 = doorway); "
+            "the largest cell of each row in bold</caption>\n<tr><th>node</th>";
+    for (int r : room_ids) html << "<th>" << r << "</th>";
+    html << "</tr>\n";
+    for (const auto& [node, rooms] : rooms_of) {
+      int best = 0;
+      for (const auto& [room, count] : rooms)
+        if (room >= 0) best = std::max(best, count);
+      html << "<tr><th><span style=\"display:inline-block;width:10px;height:10px;background:" << indexColour(node)
+           << "\"></span> " << node << "</th>";
+      for (int r : room_ids) {
+        const auto it = rooms.find(r);
+        const int count = it == rooms.end() ? 0 : it->second;
+        html << "<td>" << (count > 0 && count == best && r >= 0 ? "<b>" : "") << (count > 0 ? std::to_string(count) : "")
+             << (count > 0 && count == best && r >= 0 ? "</b>" : "") << "</td>";
       }
       html << "</tr>\n";
     }
     html << "</table>\n";
   }
+}
 
-  // 3. topology
+/// Section 1's thumbnails: about 96 frames evenly spread, bordered in their node (or place) colour.
+void writeThumbnailGrid(std::ostream& html, const ReportInputs& in, const std::vector<int>& colour, bool by_node) {
+  const std::size_t n = in.run.frames.size();
+  std::vector<std::int64_t> strip_frames;
+  const std::int64_t step = std::max<std::int64_t>(1, (static_cast<std::int64_t>(n) + 95) / 96);
+  for (std::int64_t f = 0; f < static_cast<std::int64_t>(n); f += step) strip_frames.push_back(f);
+  bool any = false;
+  std::ostringstream grid;
+  grid << "<div class=\"thumbs\">\n";
+  for (std::int64_t f : strip_frames) {
+    const auto fi = static_cast<std::size_t>(f);
+    if (fi >= in.thumbnails.size() || in.thumbnails[fi].empty()) continue;
+    any = true;
+    const int c = colour[fi];
+    grid << "<figure style=\"border-color:" << indexColour(c) << "\"><img src=\"" << in.thumbnails[fi]
+         << "\" alt=\"frame " << f << "\"><figcaption>" << f << (by_node ? " · n" : " · p") << c
+         << "</figcaption></figure>\n";
+  }
+  grid << "</div>\n";
+  if (any) {
+    html << "<p>Every " << step << (step == 1 ? "st" : "th") << " frame; the border is the frame's "
+         << (by_node ? "node" : "place") << " colour.</p>\n"
+         << grid.str();
+  }
+}
+
+/// Section 2: lambda2 over time, then the places with their representatives.
+void writeLambda2AndPlaces(std::ostream& html, const ReportInputs& in) {
+  const RunData& run = in.run;
+  const std::size_t n = run.frames.size();
+  html << "<h2>Fiedler value lambda2 over time with the place cuts (thesis Figure 4.10)</h2>\n";
+  html << "<div>" << inlineSvg(lambda2Plot(in)) << "</div>\n";
+  if (run.places.empty()) return;
+  html << "<h2>Places and their representatives</h2>\n<table class=\"eval\"><tr><th>place</th><th>frames</th>"
+          "<th>representative</th><th>node</th><th>ended by</th>"
+       << (in.rooms.size() == n ? "<th>true room (share of its frames)</th>" : "") << "</tr>\n";
+  for (const auto& p : run.places) {
+    html << "<tr><td>" << p.place << "</td><td>" << p.first << "-" << p.last << "</td><td>";
+    const auto rep = static_cast<std::size_t>(p.representative);
+    if (rep < in.thumbnails.size() && !in.thumbnails[rep].empty())
+      html << "<img src=\"" << in.thumbnails[rep] << "\" alt=\"frame " << p.representative
+           << "\" style=\"width:96px;height:72px;object-fit:cover;vertical-align:middle\"> ";
+    html << p.representative << "</td><td>" << (p.node >= 0 ? std::to_string(p.node) : "-") << "</td><td>"
+         << (p.end.empty() ? std::string("-") : escapeMarkup(p.end)) << "</td>";
+    if (in.rooms.size() == n) {
+      const std::vector<int> rooms(in.rooms.begin() + p.first, in.rooms.begin() + p.last + 1);
+      const int room = majority(rooms);
+      const auto share = static_cast<double>(std::count(rooms.begin(), rooms.end(), room)) / rooms.size();
+      html << "<td>" << (room >= 0 ? std::to_string(room) + " (" + num(100.0 * share, 0) + " %)" : std::string("-"))
+           << "</td>";
+    }
+    html << "</tr>\n";
+  }
+  html << "</table>\n";
+}
+
+/// Sections 3 and 4: the most probable topology, and its probability after each place.
+void writeTopology(std::ostream& html, const ReportInputs& in) {
+  const RunData& run = in.run;
   html << "<h2>Most probable topology (thesis Figure 5.4)</h2>\n";
   html << "<p>Each node shows the frame of its first representative; arrows are transitions between "
           "consecutive "
           "places (number = times traversed). Nodes are placed clockwise in the order they were "
           "discovered.</p>\n";
   html << renderTopologyHtml(run, in.thumbnails);
-
-  // 4. probability over time
   if (run.topology && !run.topology->history.empty()) {
     html << "<h2>Probability of the most probable topology after each place</h2>\n";
     html << "<div>" << inlineSvg(probabilityPlot(run)) << "</div>\n";
   }
+}
 
-  // 5. timing
-  if (!run.timing.empty()) {
-    html << "<h2>Processing time per frame (thesis Figures 5.6/5.7)</h2>\n";
-    std::vector<double> t_total, t_fp, t_seg, t_filt;
-    for (const auto& t : run.timing) {
-      t_total.push_back(t.fingerprint_ms + t.segment_ms + t.filter_ms.value_or(0.0));
-      t_fp.push_back(t.fingerprint_ms);
-      t_seg.push_back(t.segment_ms);
-      t_filt.push_back(t.filter_ms.value_or(0.0));
-    }
-    html << "<div>" << inlineSvg(timingPlot(run)) << "</div>\n";
-    html << "<table class=\"eval\"><caption>Time per frame, "
-            "ms</caption><tr><th>stage</th><th>mean</th><th>median</th>"
-            "<th>p99</th><th>max</th></tr>\n";
-    auto row = [&](const char* name, const std::vector<double>& v) {
-      double mean = 0;
-      for (double x : v) mean += x;
-      mean /= static_cast<double>(v.size());
-      html << "<tr><td>" << name << "</td><td>" << num(mean) << "</td><td>" << num(percentile(v, 0.5))
-           << "</td><td>" << num(percentile(v, 0.99)) << "</td><td>"
-           << num(*std::max_element(v.begin(), v.end())) << "</td></tr>\n";
-    };
-    row("fingerprint", t_fp);
-    row("segmentation", t_seg);
-    row("particle filter", t_filt);
-    row("total", t_total);
-    html << "</table>\n";
+/// Section 5: processing time per frame, plotted and summarised per stage.
+void writeTiming(std::ostream& html, const RunData& run) {
+  if (run.timing.empty()) return;
+  html << "<h2>Processing time per frame (thesis Figures 5.6/5.7)</h2>\n";
+  std::vector<double> t_total, t_fp, t_seg, t_filt;
+  for (const auto& t : run.timing) {
+    t_total.push_back(t.fingerprint_ms + t.segment_ms + t.filter_ms.value_or(0.0));
+    t_fp.push_back(t.fingerprint_ms);
+    t_seg.push_back(t.segment_ms);
+    t_filt.push_back(t.filter_ms.value_or(0.0));
   }
+  html << "<div>" << inlineSvg(timingPlot(run)) << "</div>\n";
+  html << "<table class=\"eval\"><caption>Time per frame, "
+          "ms</caption><tr><th>stage</th><th>mean</th><th>median</th>"
+          "<th>p99</th><th>max</th></tr>\n";
+  auto row = [&](const char* name, const std::vector<double>& v) {
+    double mean = 0;
+    for (double x : v) mean += x;
+    mean /= static_cast<double>(v.size());
+    html << "<tr><td>" << name << "</td><td>" << num(mean) << "</td><td>" << num(percentile(v, 0.5))
+         << "</td><td>" << num(percentile(v, 0.99)) << "</td><td>"
+         << num(*std::max_element(v.begin(), v.end())) << "</td></tr>\n";
+  };
+  row("fingerprint", t_fp);
+  row("segmentation", t_seg);
+  row("particle filter", t_filt);
+  row("total", t_total);
+  html << "</table>\n";
+}
 
-  // 6. evaluation
+/// Section 6: the evaluation against ground truth, or how to give one.
+void writeEvaluation(std::ostream& html, const ReportInputs& in) {
   html << "<h2>Evaluation against ground truth</h2>\n";
-  if (in.eval) {
-    html << "<p>Ground truth: <code>" << escapeMarkup(in.eval->truth_path) << "</code> (" << in.eval->truth_kind
-         << ").</p>\n";
-    html << formatEvalHtml(*in.eval);
-    if (in.eval->boundaries && !(in.eval->boundaries->f1 >= 0.5)) {
-      const BoundaryScore& b = *in.eval->boundaries;
-      html << "<p class=\"note\">Why the segmentation score is low: a cut counts only within " << b.tolerance
-           << " frames of the frame where the robot's position changes room. A forward camera sees the next "
-              "room through the doorway before it crosses it, and the corridor only after turning into it, so "
-              "appearance changes (and cuts) fall some frames before entering and after leaving"
-           << (std::isfinite(b.mean_offset) ? " (matched cuts: " + num(b.mean_offset, 1) + " frames on average)" : std::string())
-           << ". The place revisits judged by pose, above, score the places themselves.</p>\n";
-    }
-    if (in.eval->loop_closure && !in.eval->loop_closure->points.empty()) {
-      html << "<div>" << inlineSvg(loopClosurePlot(*in.eval)) << "</div>\n";
-    }
-  } else {
+  if (!in.eval) {
     html << "<p>No ground truth given (<code>--truth labels.csv | GT.bmp | pairs.csv</code>).</p>\n";
+    return;
   }
+  html << "<p>Ground truth: <code>" << escapeMarkup(in.eval->truth_path) << "</code> (" << in.eval->truth_kind
+       << ").</p>\n";
+  html << formatEvalHtml(*in.eval);
+  if (in.eval->boundaries && !(in.eval->boundaries->f1 >= 0.5)) {
+    const BoundaryScore& b = *in.eval->boundaries;
+    html << "<p class=\"note\">Why the segmentation score is low: a cut counts only within " << b.tolerance
+         << " frames of the frame where the robot's position changes room. A forward camera sees the next "
+            "room through the doorway before it crosses it, and the corridor only after turning into it, so "
+            "appearance changes (and cuts) fall some frames before entering and after leaving"
+         << (std::isfinite(b.mean_offset) ? " (matched cuts: " + num(b.mean_offset, 1) + " frames on average)" : std::string())
+         << ". The place revisits judged by pose, above, score the places themselves.</p>\n";
+  }
+  if (in.eval->loop_closure && !in.eval->loop_closure->points.empty()) {
+    html << "<div>" << inlineSvg(loopClosurePlot(*in.eval)) << "</div>\n";
+  }
+}
 
-  if (!in.pictures.empty()) {
-    html << "<h2>The simulated world</h2>\n";
-    for (const auto& [caption, uri] : in.pictures)
-      html << "<figure style=\"display:inline-block;margin:0 12px 12px 0\"><img src=\"" << uri << "\" alt=\""
-           << escapeMarkup(caption) << "\" style=\"max-width:560px\"><figcaption>" << escapeMarkup(caption)
-           << "</figcaption></figure>\n";
-  }
-  // The page's own image check, for the browser test: kept in the page, not shown.
+/// The simulated world's pictures (from `toposlam sim`), when given.
+void writePictures(std::ostream& html, const ReportInputs& in) {
+  if (in.pictures.empty()) return;
+  html << "<h2>The simulated world</h2>\n";
+  for (const auto& [caption, uri] : in.pictures)
+    html << "<figure style=\"display:inline-block;margin:0 12px 12px 0\"><img src=\"" << uri << "\" alt=\""
+         << escapeMarkup(caption) << "\" style=\"max-width:560px\"><figcaption>" << escapeMarkup(caption)
+         << "</figcaption></figure>\n";
+}
+
+/// The page's own image check, for the browser test: kept in the page, not shown.
+void writeImageCheckAndEnd(std::ostream& html) {
   html << "<p id=\"image-check\" hidden>images-pending</p>\n"
           "<script>\nwindow.addEventListener('load', function () {\n"
           "  var images = Array.prototype.slice.call(document.images);\n"
@@ -640,6 +666,28 @@ std::string renderReportHtml(const ReportInputs& in) {
           "  document.getElementById('image-check').textContent =\n"
           "      missing.length ? 'images-missing ' + missing.length : 'images-ok ' + images.length;\n"
           "});\n</script>\n</body></html>\n";
+}
+
+}  // namespace
+
+std::string renderReportHtml(const ReportInputs& in) {
+  const RunData& run = in.run;
+  const bool by_node = hasNodes(run);
+  std::vector<int> colour(run.frames.size());
+  for (std::size_t f = 0; f < colour.size(); ++f) colour[f] = frameColourIndex(run, f, by_node);
+  std::ostringstream html;
+  writeHead(html, in.title);
+  writeRunTable(html, in);
+  writeSummary(html, in);
+  writeStrips(html, in, colour, by_node);
+  writeColourLegend(html, in, colour, by_node);
+  writeThumbnailGrid(html, in, colour, by_node);
+  writeLambda2AndPlaces(html, in);
+  writeTopology(html, in);
+  writeTiming(html, run);
+  writeEvaluation(html, in);
+  writePictures(html, in);
+  writeImageCheckAndEnd(html);
   return html.str();
 }
 

@@ -1,11 +1,13 @@
 // The run folder's readers (see run_folder.hpp). All errors name file and line.
 #include "toposlam/run_folder/run_folder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include "toposlam/core/csv.hpp"
 #include "toposlam/run_folder/json_reader.hpp"
 
 namespace toposlam {
@@ -13,52 +15,6 @@ namespace toposlam {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string trim(const std::string& s) {
-  std::size_t b = 0, e = s.size();
-  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
-  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
-  return s.substr(b, e - b);
-}
-
-// One CSV record: fields split at commas outside double quotes; a quoted field keeps its commas and line
-// breaks, with "" for a quote (RFC 4180). Unquoted fields are trimmed.
-std::vector<std::string> splitComma(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  bool quoted = false, was_quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        cell += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        cell += c;
-      }
-    } else if (c == '"' && trim(cell).empty()) {
-      quoted = was_quoted = true;
-      cell.clear();
-    } else if (c == ',') {
-      cells.push_back(was_quoted ? cell : trim(cell));
-      cell.clear();
-      was_quoted = false;
-    } else {
-      cell += c;
-    }
-  }
-  cells.push_back(was_quoted ? cell : trim(cell));
-  return cells;
-}
-
-// True while `record` has an unclosed quoted field (its line break belongs to the field).
-bool quoteOpen(const std::string& record) {
-  bool open = false;
-  for (char c : record) open = c == '"' ? !open : open;
-  return open;
-}
 
 std::string where(const CsvTable& t, std::size_t row) { return t.path + ":" + std::to_string(t.lines[row]); }
 
@@ -78,25 +34,17 @@ CsvTable readCsv(const std::string& path) {
   if (!in) throw RunFileError(path + ": cannot open (does the file exist?)");
   CsvTable table;
   table.path = path;
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const int first_line = line_number;
-    std::string next;
-    while (quoteOpen(line) && std::getline(in, next)) {
-      ++line_number;
-      line += "\n" + next;
-    }
-    if (trim(line).empty()) continue;
-    std::vector<std::string> cells = splitComma(line);
+  CsvReader reader(in);
+  for (CsvRecord record; reader.next(record);) {
+    if (!record.problem.empty()) throw RunFileError(path + ":" + std::to_string(record.line) + ": " + record.problem);
+    std::vector<std::string> cells = std::move(record.fields);
     if (table.header.empty()) {
       table.header = std::move(cells);
       continue;
     }
     if (cells.size() < table.header.size()) cells.resize(table.header.size());  // tolerate trailing empties
     table.rows.push_back(std::move(cells));
-    table.lines.push_back(first_line);
+    table.lines.push_back(record.line);
   }
   if (table.header.empty()) throw RunFileError(path + ":1: empty file, expected a header line");
   return table;
@@ -388,10 +336,12 @@ RunData loadRun(const std::string& dir) {
   }
   run.frames = loadFrames((root / run_files::kFrames).string());
   {
-    std::ifstream header((root / run_files::kFrames).string());
-    std::string line;
-    std::getline(header, line);
-    run.has_frame_matches = (',' + line + ',').find(",match,") != std::string::npos;
+    // The header alone (loadFrames read and checked the whole file).
+    std::ifstream in((root / run_files::kFrames).string());
+    CsvReader reader(in);
+    CsvRecord header;
+    run.has_frame_matches = reader.next(header) && std::find(header.fields.begin(), header.fields.end(),
+                                                             "match") != header.fields.end();
   }
   const auto frame_count = static_cast<std::int64_t>(run.frames.size());
   // Places must lie inside frames.csv (loadPlaces already checked 0 <= first <= representative <= last).

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <system_error>
 
+#include "toposlam/core/csv.hpp"
 #include "toposlam/core/json_writer.hpp"
 #include "toposlam/platform/output_file.hpp"
 
@@ -25,14 +26,6 @@ std::string formatNumber(double value, int decimals) {
 // A number with 6 decimals, or the empty field for NaN.
 std::string optionalNumber(double value) { return std::isnan(value) ? std::string() : formatNumber(value, 6); }
 
-// A CSV field, quoted (quotes doubled) when it holds a comma, a quote or a line break.
-std::string csvField(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
 std::int64_t nodeOf(const std::vector<std::int64_t>& place_nodes, std::int64_t place) {
   if (place < 0 || place >= static_cast<std::int64_t>(place_nodes.size())) return -1;
   return place_nodes[static_cast<std::size_t>(place)];
@@ -43,7 +36,7 @@ void writePlaceRows(const fs::path& path, const std::vector<PlaceRecord>& rows) 
   out << "place,first,last,representative,keypoints,node,end\n";
   for (const PlaceRecord& p : rows)
     out << p.place << ',' << p.first << ',' << p.last << ',' << p.representative << ',' << p.keypoints << ','
-        << p.node << ',' << csvField(p.end) << '\n';
+        << p.node << ',' << quoteCsvField(p.end) << '\n';
   out.commit();
 }
 
@@ -99,7 +92,7 @@ void writeFrames(const fs::path& dir, const std::vector<FrameRecord>& rows, Fram
   out << "frame,time,name,lambda2,place,node" << (probability ? ",node_probability" : "")
       << (loop ? ",match,match_score" : "") << "\n";
   for (const FrameRecord& row : rows) {
-    out << row.frame << ',' << formatNumber(row.time_s, 6) << ',' << csvField(row.name) << ','
+    out << row.frame << ',' << formatNumber(row.time_s, 6) << ',' << quoteCsvField(row.name) << ','
         << optionalNumber(row.lambda2) << ',' << row.place << ',' << row.node;
     if (probability) out << ',' << optionalNumber(row.node_probability);
     if (loop) out << ',' << row.match << ',' << (row.match >= 0 ? formatNumber(row.match_score, 6) : std::string());

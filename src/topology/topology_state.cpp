@@ -87,14 +87,14 @@ void commitSuccessors(NodeEntry& entry, const RecentNode& recent, std::int32_t s
 }  // namespace
 
 std::shared_ptr<const TopologyState> extendState(const TopologyState& parent, std::int32_t observation,
-                                                 std::int32_t node, const TopologyFilterConfig& config) {
+                                                 std::int32_t node, int max_successors, int max_representatives) {
   assert(node >= 0 && node <= parent.nodeCount());
   auto child = std::make_shared<TopologyState>();
   child->record = std::make_shared<const HistoryRecord>(parent.record, observation, node);
   child->recent = parent.recent;
   NodeTable table = parent.nodes;
-  const int cap_successors = config.max_successors;
-  const int cap_representatives = config.max_representatives_per_node;
+  const int cap_successors = max_successors;
+  const int cap_representatives = max_representatives;
 
   NodeEntry entry;
   if (node == parent.nodeCount()) {

@@ -14,12 +14,17 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <utility>
 
-#include "toposlam/topology/topology_particle_filter.hpp"
+#include "toposlam/topology/topology_limits.hpp"
 
 namespace toposlam::topology_detail {
+
+/// A signed index or count as a container index.
+inline std::size_t idx(std::int64_t i) { return static_cast<std::size_t>(i); }
 
 inline constexpr int kTrieBits = 4;
 inline constexpr int kTrieFanout = 1 << kTrieBits;
@@ -101,8 +106,10 @@ struct TopologyState {
   int previousNode() const { return recent.size > 1 ? recent.items[1].node : -1; }
 };
 
-/// The state after assigning `observation` to `node` (node == nodeCount() creates a new node).
+/// The state after assigning `observation` to `node` (node == nodeCount() creates a new node), keeping at
+/// most `max_successors` successors and `max_representatives` representatives per node (the filter
+/// config's max_successors and max_representatives_per_node).
 std::shared_ptr<const TopologyState> extendState(const TopologyState& parent, std::int32_t observation,
-                                                 std::int32_t node, const TopologyFilterConfig& config);
+                                                 std::int32_t node, int max_successors, int max_representatives);
 
 }  // namespace toposlam::topology_detail

@@ -3,13 +3,15 @@
 // skipped, so a run goes on with the good ones.
 //
 // Fields follow RFC 4180 quoting: a field holding a comma or a double quote is written in double quotes
-// with inner quotes doubled ("a,b.jpg" or "say ""hi"".jpg"). quoteCsvField writes such fields, so files
-// written by the project (e.g. localize --out) read back unambiguously.
+// with inner quotes doubled ("a,b.jpg" or "say ""hi"".jpg"). quoteCsvField (core/csv.hpp, included here
+// for the writers of such files) writes such fields, so files written by the project (e.g. localize
+// --out) read back unambiguously.
 #pragma once
 
 #include <string>
-#include <string_view>
 #include <vector>
+
+#include "toposlam/core/csv.hpp"
 
 namespace toposlam {
 
@@ -28,9 +30,5 @@ struct LabelledImageList {
 /// trimmed; exactly two non-empty fields per line; an unterminated quote or text after a closing quote
 /// is a bad line. Throws std::runtime_error when the file cannot be opened.
 LabelledImageList readLabelledImageList(const std::string& csv_path);
-
-/// `field` as one CSV field: unchanged unless it holds a comma, a double quote, a line break or
-/// leading/trailing space, in which case it is quoted with inner quotes doubled.
-std::string quoteCsvField(std::string_view field);
 
 }  // namespace toposlam

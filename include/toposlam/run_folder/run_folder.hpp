@@ -205,7 +205,8 @@ std::vector<FrameRecord> frameRows(const SegmentationRun& run, const std::vector
 std::vector<PlaceRecord> placeRows(const std::vector<SegmentedPlace>& places,
                                    const std::vector<std::int64_t>& place_nodes = {});
 
-/// frames.csv. Names are quoted as CSV fields when they hold a comma, a quote or a line break.
+/// frames.csv. Names are quoted as CSV fields when they hold a comma, a quote or a line break or start or
+/// end with white space (quoteCsvField).
 void writeFrames(const std::filesystem::path& dir, const std::vector<FrameRecord>& rows, FrameColumns columns);
 /// places.csv: `place,first,last,representative,keypoints,node,end`.
 void writePlaces(const std::filesystem::path& dir, const std::vector<PlaceRecord>& rows);

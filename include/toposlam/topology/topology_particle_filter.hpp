@@ -46,6 +46,7 @@
 #include "toposlam/fingerprint/fingerprint.hpp"
 #include "toposlam/matching/similarity_measure.hpp"
 #include "toposlam/topology/place_candidate_index.hpp"
+#include "toposlam/topology/topology_limits.hpp"
 
 namespace toposlam {
 
@@ -54,10 +55,6 @@ struct TopologyState;
 struct HistoryRecord;
 class TrieNode;
 }  // namespace topology_detail
-
-/// Largest allowed max_successors and max_representatives_per_node (fixed-size node entries).
-inline constexpr int kTopologyMaxSuccessors = 8;
-inline constexpr int kTopologyMaxRepresentatives = 16;
 
 /// How a stored representative's similarity with the new one becomes its appearance likelihood.
 enum class LikelihoodModel : std::uint8_t {
@@ -284,8 +281,31 @@ class TopologyParticleFilter {
   enum class Phase : std::uint8_t { Idle, Collect, Propose, Similarity, Aggregate, Resample, Update };
   using StatePtr = std::shared_ptr<const topology_detail::TopologyState>;
 
+  /// Work items one advance() call may still run: each phase takes one per item and stops (returns
+  /// false, to resume at cursor_) when none is left.
+  struct WorkBudget {
+    std::size_t used = 0;
+    std::size_t limit = 0;
+    bool take() { return used++ < limit; }
+  };
+
   double uniform01();
   void finishStep();
+  // The phases of a step, in order (each returns false when the budget ran out before it finished).
+  /// Which stored representatives some particle still refers to (needed_list_); the others are forgotten.
+  bool collectStored(WorkBudget& work);
+  /// Step 1: each particle draws its next node from the transition model (proposal_).
+  bool proposeNodes(WorkBudget& work);
+  /// Step 2: the new representative (and samples) against the stored ones, into likelihoods.
+  bool compareWithStored(WorkBudget& work);
+  /// Per distinct topology: its best known-node likelihood and its new node's likelihood (group_stats_).
+  bool aggregatePerTopology(WorkBudget& work);
+  /// Steps 3 and 4: weigh the proposals, then systematic resampling (chosen_).
+  bool resample(WorkBudget& work);
+  /// Step 3: each particle's weight, the appearance likelihood of its proposal (weight_).
+  void weighProposals();
+  /// Step 5: the chosen particles' states extended by their proposals (next_particles_), then finishStep.
+  bool updateMap(WorkBudget& work);
   /// LikelihoodModel::Relative: turns this step's similarities into relative likelihoods, in place.
   void relativeLikelihoods();
   /// After Collect: which stored representatives step 1 compares exactly (compared_list_).

@@ -4,8 +4,9 @@
 
 #include <cmath>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
+
+#include "toposlam/core/csv.hpp"
 
 namespace toposlam::cli {
 namespace {
@@ -23,28 +24,27 @@ double number(const std::string& field, const std::string& where, const char* wh
 std::vector<MotionCsvSample> readMotionCsv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("--motion: cannot read '" + path + "'");
-  std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error("--motion: '" + path + "' is empty");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  const bool with_turn = line == "time_s,distance_m,speed_mps,turn_rate_rps";
-  if (line != "time_s,distance_m,speed_mps" && !with_turn)
-    throw std::runtime_error("--motion: " + path + ":1: header must be 'time_s,distance_m,speed_mps' (and optionally "
-                             "',turn_rate_rps'), got '" + line + "'");
+  CsvReader reader(in);
+  CsvRecord record;
+  if (!reader.next(record)) throw std::runtime_error("--motion: '" + path + "' is empty");
+  const std::string& header = record.text;
+  const bool with_turn = header == "time_s,distance_m,speed_mps,turn_rate_rps";
+  if (header != "time_s,distance_m,speed_mps" && !with_turn)
+    throw std::runtime_error("--motion: " + path + ":" + std::to_string(record.line) +
+                             ": header must be 'time_s,distance_m,speed_mps' (and optionally "
+                             "',turn_rate_rps'), got '" + header + "'");
   const std::string fields = with_turn ? "4 fields (time_s,distance_m,speed_mps,turn_rate_rps)" : "3 fields (time_s,distance_m,speed_mps)";
   std::vector<MotionCsvSample> samples;
-  for (int number_of_line = 2; std::getline(in, line); ++number_of_line) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const std::string where = "--motion: " + path + ":" + std::to_string(number_of_line);
-    std::istringstream row(line);
-    std::string t, d, v, w, extra;
-    if (!std::getline(row, t, ',') || !std::getline(row, d, ',') || !std::getline(row, v, ',') ||
-        (with_turn && !std::getline(row, w, ',')) || std::getline(row, extra, ','))
-      throw std::runtime_error(where + ": expected " + fields + ", got '" + line + "'");
-    MotionCsvSample s{number(t, where, "time_s"), number(d, where, "distance_m"), number(v, where, "speed_mps"),
-                      with_turn ? number(w, where, "turn_rate_rps") : 0.0};
+  while (reader.next(record)) {
+    const std::string where = "--motion: " + path + ":" + std::to_string(record.line);
+    if (!record.problem.empty()) throw std::runtime_error(where + ": " + record.problem);
+    const std::vector<std::string>& f = record.fields;
+    if (f.size() != (with_turn ? 4u : 3u))
+      throw std::runtime_error(where + ": expected " + fields + ", got '" + record.text + "'");
+    MotionCsvSample s{number(f[0], where, "time_s"), number(f[1], where, "distance_m"), number(f[2], where, "speed_mps"),
+                      with_turn ? number(f[3], where, "turn_rate_rps") : 0.0};
     if (!samples.empty() && s.time_s < samples.back().time_s)
-      throw std::runtime_error(where + ": time_s " + t + " goes back in time");
+      throw std::runtime_error(where + ": time_s " + f[0] + " goes back in time");
     samples.push_back(s);
   }
   if (samples.empty()) throw std::runtime_error("--motion: '" + path + "' has no samples");
