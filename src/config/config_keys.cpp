@@ -518,7 +518,13 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(real("topology.sequence_evidence.keyframe_interval_s", AT(sequence_evidence.loop.keyframe_interval_s), 1.0,
                    0.01, 1e6, "s", "one keyframe at most this often"));
   k.push_back(real("topology.sequence_evidence.memory_s", AT(sequence_evidence.memory_s), 40.0, 0.02, 1e6, "s",
-                   "the longest memory of a run of matches (time constant); must exceed the keyframe interval"));
+                   "the longest memory of a run of matches (time constant); must exceed the keyframe interval")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    const SequenceEvidenceConfig& e = c.sequence_evidence;
+                    if (e.memory_s > e.loop.keyframe_interval_s) return "";
+                    return rangeNumber(e.memory_s) + " is out of range, allowed above keyframe_interval_s = " +
+                           rangeNumber(e.loop.keyframe_interval_s) + " s";
+                  }));
   k.push_back(integer("topology.sequence_evidence.scales", AT(sequence_evidence.loop.scales), 3, 1, 8, "",
                       "memories integrated side by side, each 4 times shorter than the one before"));
   k.push_back(integer("topology.sequence_evidence.exhaustive_up_to", AT(sequence_evidence.exhaustive_up_to), 1000, 0,
@@ -532,7 +538,14 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(integer("topology.sequence_evidence.statistics_sample", AT(sequence_evidence.statistics_sample), 128, 2,
                       100000, "keyframes", "large maps: keyframes compared for the similarities' mean and spread"));
   k.push_back(real("topology.sequence_evidence.min_gap_s", AT(sequence_evidence.min_gap_s), 20.0, 0.01, 1e6, "s",
-                   "matches at least this long back"));
+                   "matches at least this long back")
+                  .withCrossCheck([](const DaemonConfig& c) -> std::string {
+                    const SequenceEvidenceConfig& e = c.sequence_evidence;
+                    const double interval = e.loop.keyframe_interval_s;
+                    if (e.min_gap_s >= interval && e.min_gap_s / interval <= 1e6) return "";
+                    return rangeNumber(e.min_gap_s) + " is out of range, allowed [keyframe_interval_s = " +
+                           rangeNumber(interval) + ", 1e6 x keyframe_interval_s] s";
+                  }));
   // Large maps (CandidateSelectionConfig; docs/topology.md): exhaustive up to a size, then an index.
   k.push_back(integer("topology.candidates.exhaustive_up_to", AT(topology.candidates.exhaustive_up_to), 1000, 0,
                       1000000000, "representatives",

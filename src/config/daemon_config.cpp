@@ -137,9 +137,12 @@ void readSection(const YAML::Node& node, const std::string& section, DaemonConfi
   }
 }
 
-void readConfig(const YAML::Node& root, DaemonConfig& c) {
+void readConfig(const YAML::Node& root, DaemonConfig& c, const std::string& preset_override) {
   // The preset first, wherever it is written: it gives every stage's settings, the other keys override them.
-  if (root.IsMap()) {
+  // The command line's preset, if any, in place of the text's.
+  if (!preset_override.empty()) {
+    readKey(daemonConfigKey("preset"), YAML::Node(preset_override), c);
+  } else if (root.IsMap()) {
     const YAML::Node& map = root;  // const look-up: the non-const operator[] would insert the key
     if (const YAML::Node preset = map["preset"]; preset.IsDefined()) readKey(daemonConfigKey("preset"), preset, c);
   }
@@ -258,13 +261,14 @@ std::string DaemonConfig::validate() const {
       {"segmentation (FiedlerSegmenterConfig)", segmentation.validate()},
       {"segmentation.motion (MotionGateConfig)", segmentation_stage.motion.validate()},
       {"topology (TopologyFilterConfig)", topology.validate()},
+      {"topology.sequence_evidence (SequenceEvidenceConfig)", sequence_evidence.validate()},
   };
   for (const auto& [stage, problem] : stages)
     if (!problem.empty()) return std::string(stage) + ": " + problem;
   return "";
 }
 
-DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin) {
+DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin, const std::string& preset) {
   YAML::Node root;
   try {
     // A second document ("---") would be ignored silently by YAML::Load: refused instead. Found by
@@ -287,7 +291,7 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
   }
   DaemonConfig config;
   try {
-    readConfig(root, config);
+    readConfig(root, config, preset);
   } catch (const ConfigError& e) {
     throw ConfigError(origin + ": " + e.what());
   } catch (const std::invalid_argument& e) {
@@ -304,7 +308,7 @@ void setConfigValue(DaemonConfig& config, const std::string& path, const std::st
   key.set(config, value);
 }
 
-DaemonConfig loadDaemonConfig(const std::string& path) {
+DaemonConfig loadDaemonConfig(const std::string& path, const std::string& preset) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error))
     throw ConfigError("the config file '" + path + "' is a folder; give the YAML file in it (e.g. " +
@@ -319,7 +323,52 @@ DaemonConfig loadDaemonConfig(const std::string& path) {
   if (text.size() > kMaxConfigBytes)
     throw ConfigError("the config file '" + path + "' is larger than " + std::to_string(kMaxConfigBytes >> 10) +
                       " KiB; is it really a toposlam config?");
-  return parseDaemonConfig(text, path);
+  return parseDaemonConfig(text, path, preset);
+}
+
+ConfigOverride parseSetOverride(const std::string& assignment) {
+  const std::size_t equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0)
+    throw ConfigError("command line: --set " + assignment + ": expected KEY=VALUE, e.g. --set segmentation.window_s=6");
+  ConfigOverride o{assignment.substr(0, equals), assignment.substr(equals + 1), "--set " + assignment};
+  if (!keyTree().keys.count(o.path)) {
+    std::string hint;
+    if (keyTree().isSection(o.path)) hint = " ('" + o.path + "' is a section; name one of its keys)";
+    throw ConfigError("command line: --set " + assignment + ": unknown key '" + o.path + "'" + hint +
+                      " (the keys: docs/config.md, or `toposlam config --print`)");
+  }
+  return o;
+}
+
+DaemonConfig commandLineConfig(const std::string& path, const std::vector<ConfigOverride>& overrides) {
+  std::string preset;
+  for (const ConfigOverride& o : overrides)
+    if (o.path == "preset") preset = o.text;
+  if (!preset.empty()) {
+    try {
+      DaemonConfig probe;
+      setConfigValue(probe, "preset", preset);  // an unknown name: said as the user wrote it
+    } catch (const ConfigError& e) {
+      for (const ConfigOverride& o : overrides)
+        if (o.path == "preset" && o.text == preset) throw ConfigError("command line: " + o.given_as + ": " + e.what());
+    }
+  }
+  DaemonConfig config;
+  if (!path.empty()) {
+    config = loadDaemonConfig(path, preset);
+  } else if (!preset.empty()) {
+    applyMethodPreset(preset, config);
+  }
+  for (const ConfigOverride& o : overrides) {
+    if (o.path == "preset") continue;  // applied first
+    try {
+      setConfigValue(config, o.path, o.text);
+    } catch (const ConfigError& e) {
+      throw ConfigError("command line: " + o.given_as + ": " + e.what());
+    }
+  }
+  if (std::string problem = config.validate(); !problem.empty()) throw ConfigError("command line: " + problem);
+  return config;
 }
 
 }  // namespace toposlam

@@ -15,7 +15,6 @@ MethodPreset methodPreset(const std::string& name) {
   p.similarity = similarity.similarity;
   if (name == "default") {
     p.segmentation.window_s = 6.0;
-    p.segmentation.window = 100;
     p.segmentation.min_window_frames = 5;
     p.segmentation.min_frame_spacing_m = 0.09;  // with motion and window_m only (docs/segmentation.md)
     p.segmentation.min_frame_spacing_rad = 0.03;

@@ -227,6 +227,7 @@ void ParticleFilterTopologyStage::loadMap(const std::string& path) { adoptMap(Ma
 void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   filter_ = std::move(loaded.filter);
   filter_->setCandidateSelection(candidates_);  // how this process compares, not saved with the map
+  topology_.particles = filter_->config().particles;  // the map's, as every other setting of its filter
   // The application data lists the representative frames of the run that saved the map; frame numbers of
   // an older run mean nothing in this one, so resumed observations show -1.
   representative_frames_.assign(static_cast<std::size_t>(filter_->observationCount()), -1);

@@ -1,5 +1,6 @@
 // Pipeline: the five stage threads and the queues between them; see the header for the shape.
 #include "toposlam/pipeline/pipeline.hpp"
+#include "toposlam/pipeline/frame_failures.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -293,7 +294,7 @@ void Pipeline::captureLoop() {
 }
 
 void Pipeline::fingerprintLoop() {
-  std::int64_t failures = 0;
+  FrameFailures failures;  // the one per-frame error policy (frame_failures.hpp)
   try {
     for (;;) {
       CapturedFrame captured;
@@ -311,7 +312,8 @@ void Pipeline::fingerprintLoop() {
         out.thumbnail = std::move(made.thumbnail);
       } catch (const std::exception& e) {
         // A bad frame from the world: counted, logged now and then, survived.
-        if (failures++ % 100 == 0) spdlog::warn("fingerprint: frame {} skipped ({} so far): {}", captured.frame.sequence, failures, e.what());
+        if (failures.count())
+          spdlog::warn("fingerprint: frame {} skipped ({} so far): {}", captured.frame.sequence, failures.total(), e.what());
         last_frame_failed_s_.store(clock_.now());
         continue;
       }

@@ -114,6 +114,29 @@ SCENARIO("GIVEN the key table WHEN a DaemonConfig is default-constructed THEN ev
   CHECK(defaults.validate().empty());
 }
 
+SCENARIO("GIVEN the stage structs as constructed WHEN compared with the key table THEN they hold its defaults, "
+         "but for the keys the default preset writes") {
+  DaemonConfig structs;
+  static_cast<StageSettings&>(structs) = StageSettings{};  // every stage's struct as constructed, no preset
+  std::set<std::string> differ;
+  for (const ConfigKey& key : daemonConfigKeys())
+    if (key.path != "preset" && key.get(structs) != key.default_value) differ.insert(key.path);
+  // segmentation.window: one default (100), the table's; the struct's was 30 and the preset's 100.
+  CHECK(differ.count("segmentation.window") == 0);
+  CHECK(std::get<long long>(daemonConfigKey("segmentation.window").default_value) == FiedlerSegmenterConfig{}.window);
+  // The rest: what the "default" preset (method_preset.cpp, similarity_preset.cpp) measured on real frames,
+  // over the stage structs, which keep the thesis' (or neutral) values for the algorithms' own tests.
+  CHECK(differ == std::set<std::string>{
+                      "fingerprint.keypoints.orb_levels", "segmentation.doorway_borders", "segmentation.doorway_shift_s",
+                      "segmentation.min_frame_spacing_m", "segmentation.min_frame_spacing_rad",
+                      "segmentation.place_samples", "segmentation.window_s", "similarity.histogram_only_fallback",
+                      "similarity.histogram_weight", "similarity.keypoint_scoring",
+                      "similarity.matcher.max_angle_difference_deg", "similarity.matcher.mutual_check",
+                      "similarity.matcher.ratio_test", "topology.gamma_scale", "topology.gamma_shape",
+                      "topology.likelihood", "topology.new_node_entropy", "topology.new_node_likelihood_floor",
+                      "topology.new_node_probability", "topology.relative_offset", "topology.relative_slope"});
+}
+
 SCENARIO("GIVEN the effective config printed as YAML WHEN it is read back THEN every key has its value again") {
   GIVEN("the defaults") {
     const std::string printed = configYaml(DaemonConfig{}, false);

@@ -310,3 +310,58 @@ SCENARIO("GIVEN the fuzz corpus's alias and octal-looking configs WHEN each is r
     }
   }
 }
+
+SCENARIO("GIVEN a config file and command-line overrides WHEN the command line's config is made THEN the preset comes "
+         "first, then the file, then the overrides in order, each refused by its key") {
+  const std::string file = TOPOSLAM_BINARY_DIR "/command-line-config.yaml";
+  {
+    std::ofstream out(file);
+    out << "preset: default\nsegmentation:\n  window_s: 4\ntopology:\n  particles: 200\n";
+  }
+  WHEN("the command line names the thesis preset and sets one key the file sets too") {
+    const DaemonConfig c = commandLineConfig(
+        file, {{"preset", "thesis", "--preset"}, parseSetOverride("topology.particles=300")});
+    THEN("the thesis preset replaces the file's, the file's keys override it and --set overrides the file") {
+      CHECK(c.preset == "thesis");
+      CHECK(c.segmentation.window == 25);       // the thesis preset's
+      CHECK(c.segmentation.window_s == 4.0);    // the file's, over the preset
+      CHECK(c.topology.particles == 300);       // --set, over the file
+      CHECK(c.topology.likelihood == LikelihoodModel::Absolute);
+    }
+  }
+  WHEN("no file is given") {
+    const DaemonConfig c = commandLineConfig("", {parseSetOverride("segmentation.window=40")});
+    THEN("the built-in defaults take the override") {
+      CHECK(c.preset == "default");
+      CHECK(c.segmentation.window == 40);
+      CHECK(c.segmentation.window_s == 6.0);
+    }
+  }
+  WHEN("overrides are out of range, unknown, malformed or break a cross-key constraint") {
+    const auto error = [&](const std::vector<std::string>& sets) -> std::string {
+      try {
+        std::vector<ConfigOverride> overrides;
+        for (const std::string& set : sets) overrides.push_back(parseSetOverride(set));
+        commandLineConfig("", overrides);
+      } catch (const ConfigError& e) {
+        return e.what();
+      }
+      return "";
+    };
+    THEN("each is refused naming the option as given and the key") {
+      CHECK(error({"segmentation.window=2"}) ==
+            "command line: --set segmentation.window=2: segmentation.window: 2 is out of range, allowed 3 .. 1000 frames");
+      CHECK(error({"topology.particles=many"}) ==
+            "command line: --set topology.particles=many: topology.particles: expected an integer in 1 .. 1000000, "
+            "got 'many'");
+      CHECK(error({"segmentation.windw=20"}).rfind("command line: --set segmentation.windw=20: unknown key "
+                                                   "'segmentation.windw'", 0) == 0);
+      CHECK(error({"segmentation=20"}).find("'segmentation' is a section") != std::string::npos);
+      CHECK(error({"segmentation.window"}) ==
+            "command line: --set segmentation.window: expected KEY=VALUE, e.g. --set segmentation.window_s=6");
+      CHECK(error({"segmentation.window=4"}) ==
+            "command line: segmentation.min_window_frames: 5 is out of range, allowed 3 .. window (4) frames");
+      CHECK(error({"preset=paper"}).rfind("command line: --set preset=paper: preset: 'paper' is not allowed", 0) == 0);
+    }
+  }
+}

@@ -63,8 +63,10 @@ SCENARIO("The two-traversal simulated office gives the right topology", "[segmen
       REQUIRE(route.fingerprints.size() == 1618);
       REQUIRE(route.traversal_starts.size() == 2);
       const NgramSimilarity similarity;
-      MappingScore score = testing::mapRoute(route, FiedlerSegmenterConfig{}, similarity);
-      printScore("office-loop2", FiedlerSegmenterConfig{}, score);
+      FiedlerSegmenterConfig config;
+      config.window = 30;  // 30 frames, 6 s at 5 fps
+      MappingScore score = testing::mapRoute(route, config, similarity);
+      printScore("office-loop2", config, score);
       return score;
     }();
     const SecondTraversal second = secondTraversal(s);
@@ -97,6 +99,7 @@ TEST_CASE("DETAIL of one configuration (TUNE_ROUTE=world, TUNE_CONFIG='window fl
   const char* world = std::getenv("TUNE_ROUTE");
   const char* text = std::getenv("TUNE_CONFIG");
   FiedlerSegmenterConfig config;
+  config.window = 30;  // a window of 30 frames (window_s 0), unless the text says otherwise
   if (text != nullptr) {
     std::istringstream in(text);
     in >> config.window >> config.similarity_floor >> config.valley.gamma >> config.valley.delta;

@@ -39,11 +39,12 @@ TEST_CASE(
   const toposlam::NgramSimilarity similarity;
 
   SECTION(
-      "default window (30 frames, 30 s here): the window spans three quarters of the 40-frame lap, lambda2 "
+      "a window of 30 frames (30 s here): the window spans three quarters of the 40-frame lap, lambda2 "
       "stays in [0.55, 0.95], one place") {
-    REQUIRE(toposlam::FiedlerSegmenterConfig{}.window == 30);
+    toposlam::FiedlerSegmenterConfig config;
+    config.window = 30;
     toposlam::VpackFingerprintStage fingerprint_stage(toposlam::VpackConfig{}, nullptr);
-    toposlam::FiedlerSegmentationStage segmentation_stage(toposlam::FiedlerSegmenterConfig{}, similarity, 1);
+    toposlam::FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
     toposlam::OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
     for (std::size_t i = 0; i < frames.size(); ++i)
       pipeline.process(frames[i], static_cast<double>(i), std::to_string(i + 1) + ".jpg");

@@ -36,6 +36,7 @@ TEST_CASE("GIVEN a full window WHEN frames keep arriving and places close THEN a
   auto block = [](int f) { return f / 40; };
   toposlam::test::TableSimilarity similarity([&](int a, int b) { return block(a) == block(b) ? 0.9 : 0.05; });
   toposlam::FiedlerSegmenterConfig config;
+  config.window = 30;  // a window of 30 frames (window_s 0)
   SECTION("the window-degree representative") {}
   SECTION("the place-medoid representative, its samples thinned") {
     config.representative = toposlam::RepresentativeChoice::PlaceMedoid;

@@ -324,7 +324,8 @@ TEST_CASE(
     return 0.9 + 0.05 * std::sin(0.7 * a + 1.3 * b);
   });
   FiedlerSegmenterConfig plain;
-  FiedlerSegmenterConfig floored;
+  plain.window = 30;  // a window of 30 frames (window_s 0)
+  FiedlerSegmenterConfig floored = plain;
   floored.similarity_floor = 0.3;
   FiedlerSegmenter without_floor(plain, similarity);
   FiedlerSegmenter with_floor(floored, similarity);

@@ -9,11 +9,13 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
+#include "toposlam/pipeline/stage_assembly.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
@@ -50,7 +52,9 @@ struct RecordSettings {
   int queue_frames = 16;       ///< frames waiting for the writer before the oldest is dropped, 1 .. 1024
 };
 
-struct DaemonConfig {
+/// The stages' settings (fingerprint, similarity, segmentation, topology: StageSettings, the members
+/// StageAssembly builds the stages from) and the daemon's own.
+struct DaemonConfig : StageSettings {
   /// Method preset (method_preset.hpp): "default" (measured on real frames) or "thesis"; it sets every
   /// stage's settings before the other keys are read.
   std::string preset = "default";
@@ -64,14 +68,6 @@ struct DaemonConfig {
   MapConfig map;
   WatchdogConfig watchdog;  ///< watchdog.*: the Pipeline's heartbeat, toposlamd's systemd pings
   PipelineConfig pipeline;  ///< pipeline.*: queues, threads, budgets
-  VpackConfig fingerprint;
-  FingerprintStageConfig fingerprint_stage;  ///< fingerprint.workers
-  NgramSimilarityConfig similarity;
-  FiedlerSegmenterConfig segmentation;
-  SegmentationStageConfig segmentation_stage;  ///< segmentation.motion.*
-  TopologyFilterConfig topology;
-  TopologyStageConfig topology_stage;          ///< topology.slice_items, topology.alternatives
-  SequenceEvidenceConfig sequence_evidence;  ///< topology.sequence_evidence.* (docs/topology.md)
 
   DaemonConfig();
   /// "" or "<full.dotted.key>: <problem, allowed range>": every key's range and cross-key constraint of
@@ -85,16 +81,40 @@ void applyMethodPreset(const std::string& name, DaemonConfig& config);
 
 /// Parses YAML text onto the defaults. `origin` names the text in messages (a file name).
 /// Throws ConfigError on syntax errors, unknown keys, wrong types and out-of-range values.
-DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin = "config");
+/// `preset` (not ""): the command line's preset, applied instead of the text's own `preset:` key (before the
+/// text's other keys, as the text's own preset would be).
+DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin = "config",
+                               const std::string& preset = "");
 /// A config file larger than this is refused (bytes).
 inline constexpr std::size_t kMaxConfigBytes = 1 << 20;
 /// Reads and parses a file; ConfigError if it cannot be read, is a folder or is over kMaxConfigBytes.
 /// A repeated key or a second YAML document is refused (parseDaemonConfig).
-DaemonConfig loadDaemonConfig(const std::string& path);
+DaemonConfig loadDaemonConfig(const std::string& path, const std::string& preset = "");
 
 /// Sets the key at `path` (a key of the table) from its text as written on a command line, e.g.
 /// ("map.save_period_s", "30"); ConfigError naming the key if the text is not a value of its kind.
 /// Ranges are checked by validate().
 void setConfigValue(DaemonConfig& config, const std::string& path, const std::string& text);
+
+/// One key set on a command line: the key's path, its value as text, and how the user wrote it for
+/// messages ("--set segmentation.window_s=6", "--window-s").
+struct ConfigOverride {
+  std::string path;
+  std::string text;
+  std::string given_as;
+};
+
+/// The override of `--set KEY=VALUE` (`assignment` is "KEY=VALUE"); ConfigError "command line: --set TEXT:
+/// ..." when it
+/// has no '=' or KEY is no key of the table.
+ConfigOverride parseSetOverride(const std::string& assignment);
+
+/// The one way a command line makes its config (toposlamd and the offline commands alike): the file at
+/// `path` ("" = the built-in defaults), then `overrides` in order, then validate(). A `preset` override is
+/// applied first, in place of the file's own `preset:` (a preset sets every stage; the other keys, of the
+/// file and of the command line, override it). ConfigError "<file>: <key>: <problem>", "command line:
+/// <given_as>: <key>: <problem>" for a value of the wrong kind or out of the key's range, "command line:
+/// <key>: <problem>" for a cross-key constraint.
+DaemonConfig commandLineConfig(const std::string& path, const std::vector<ConfigOverride>& overrides);
 
 }  // namespace toposlam

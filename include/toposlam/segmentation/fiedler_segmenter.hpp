@@ -1,7 +1,7 @@
 // Online place segmentation by algebraic connectivity (thesis chapter 4).
 //
-// Each new frame joins a sliding window of the last n frames (default 25). Only its similarities with
-// the other n-1 frames are computed (2 (n-1) calls to SimilarityMeasure::similarity, the mean of both
+// Each new frame joins a sliding window of the last n frames (the thesis' 25) or seconds. Only its
+// similarities with the other n-1 frames are computed (2 (n-1) calls to SimilarityMeasure::similarity, the mean of both
 // directions); the rest of the symmetric affinity matrix A (zero diagonal) is cached. The window is a
 // ring: a frame keeps its slot (row/column of A) until it leaves, and since eigenvalues do not depend on
 // the order of the nodes, A is never shifted. From A: degrees d_i = sum_j a_ij, the normalised
@@ -82,9 +82,10 @@ struct FiedlerSegmenterConfig {
   /// the places found do not depend on the frame rate. Allowed [0, 3600]; 0 = count frames instead
   /// (exactly `window` frames). Thesis: 25 frames at ~5 fps, i.e. 5 s.
   double window_s = 0.0;
-  /// With window_s = 0: frames in the window, allowed [3, 1000]; thesis 25, ours 30 with delta 0.30
-  /// (docs/segmentation.md, "Defaults"). With window_s > 0: the most frames the window may hold.
-  int window = 30;
+  /// With window_s = 0: frames in the window, allowed [3, 1000]; thesis 25 (its preset). With window_s > 0:
+  /// the most frames the window may hold. The default is the key table's (segmentation.window; a test holds
+  /// them equal).
+  int window = 100;
   /// With window_s > 0 or window_m > 0: the fewest frames the window keeps however long (or far) they
   /// took; allowed [3, window].
   int min_window_frames = 5;

@@ -29,7 +29,7 @@
 #include "toposlam/matching/labelled_image_list.hpp"
 #include "toposlam/matching/place_localizer.hpp"
 #include "toposlam/matching/place_route_filter.hpp"
-#include "toposlam/matching/similarity_preset.hpp"
+#include "config_options.hpp"
 
 namespace toposlam::cli {
 
@@ -40,10 +40,9 @@ struct LocalizeOptions {
   std::string queries;
   std::vector<double> thresholds = {0.5, 0.6, 0.7, 0.8, 0.9};
   std::string out;
-  std::string keypoints = "orb";
+  ConfigOptions config;  ///< -c, --set, --preset, --keypoints: the fingerprint and similarity sections
   bool normalise_counts = false;
   bool json = false;
-  std::string preset = "default";
   bool route = false;
   PlaceRouteFilterConfig route_filter;
 };
@@ -99,10 +98,8 @@ void runLocalize(const LocalizeOptions& o) {
   const LabelledImageList place_list = readListReporting(o.places, problems);
   const LabelledImageList query_list = readListReporting(o.queries, problems);
 
-  const SimilarityPreset preset = similarityPreset(o.preset);
-  VpackConfig vpack = preset.fingerprint;
-  vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
-  const VpackExtractor extractor(vpack);
+  const DaemonConfig settings = commandConfig(o.config);  // toposlamd's fingerprint and similarity
+  const VpackExtractor extractor(settings.fingerprint);
 
   // Places in order of their label's first appearance; several images with one label are its references.
   std::vector<LabelledPlace> places;
@@ -123,7 +120,7 @@ void runLocalize(const LocalizeOptions& o) {
                              " problems reported above)");
 
   PlaceLocalizerConfig config;
-  config.similarity = preset.similarity;
+  config.similarity = settings.similarity;
   config.normalise_counts = o.normalise_counts;
   const PlaceLocalizer localizer(config, std::move(places));
 
@@ -231,12 +228,11 @@ void addLocalizeCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Write one prediction per query: image,expected,label,probability,correct");
-  addKeypointBackendOption(*cmd, options->keypoints);
+  addConfigOptions(*cmd, options->config);
+  addKeyAlias(*cmd, options->config, "--keypoints", "fingerprint.keypoints.backend");
   cmd->add_flag("--normalise-counts", options->normalise_counts,
                 "Divide each place's n-gram counts by the n-grams its representative could have had");
   cmd->add_flag("--json", options->json, "Print JSON instead of the table");
-  cmd->add_option("--preset", options->preset, "Method preset: default (measured on real frames) or thesis")
-      ->capture_default_str();
   CLI::Option* route = cmd->add_flag("--route", options->route,
                 "Queries are one traversal in file order through the places in route order (file order): "
                 "filter each query's place probabilities along the route");

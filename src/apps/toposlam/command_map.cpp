@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "config_key_options.hpp"
+#include "config_options.hpp"
 #include "offline_run_io.hpp"
 #include "toposlam/config/config_keys.hpp"
 #include "toposlam/config/daemon_config.hpp"
@@ -41,6 +41,8 @@
 #include "toposlam/platform/programs.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/pipeline/offline_runner.hpp"
+#include "toposlam/pipeline/stage_assembly.hpp"
+#include "toposlam/pipeline/frame_failures.hpp"
 #include "toposlam/run_folder/run_folder.hpp"
 #include "toposlam/topology/frame_loop_closures.hpp"
 #include "toposlam/pipeline/map_files.hpp"
@@ -60,42 +62,14 @@ namespace fs = std::filesystem;
 struct MapOptions {
   std::vector<std::string> sources;
   std::string out;
-  int particles = keyDefaultInt("topology.particles");
-  double alpha = daemonConfigKey("topology.alpha").defaultNumber();
-  std::uint64_t seed = static_cast<std::uint64_t>(daemonConfigKey("topology.seed").defaultNumber());
-  int max_representatives = keyDefaultInt("topology.max_representatives_per_node");
   std::string resume;
   bool resume_other_source = false;  ///< --resume-other-source: continue a map made from another source
   bool resume_other_settings = false;  ///< --resume-other-settings: continue a map made with other settings
-  std::string keypoints = "orb";
-  SegmentationOptions segmentation;
+  ConfigOptions config;  ///< -c, --set, --preset and the aliases of the keys (config_options.hpp)
   MotionOptions motion;
-  std::string frame_loops = "sequence";  ///< frame-level loop closures: sequence (default) or visits
-  bool json = false;                     ///< --json: the summary as one JSON object on stdout
-  bool quiet = false;                    ///< --quiet: no progress and no per-place lines on stderr
-  CLI::Option* frame_loops_given = nullptr;
-  int loop_min_gap = 10;  ///< visits: detections at least this many frames back
-  /// The sequence detector and its evidence (--loop-*, --keyframe-interval-s, --sequence-evidence*); the
-  /// default preset's, frame_revisits from --frame-loops.
-  SequenceEvidenceConfig sequence = methodPreset("default").sequence_evidence;
-  int max_keypoints = -1;             ///< -1: the preset's
-  CandidateSelectionConfig candidates;  ///< large maps: --exhaustive-up-to, --candidates
-  std::string likelihood = toString(methodPreset("default").topology.likelihood);
-  double relative_slope = methodPreset("default").topology.relative_slope;
-  double relative_offset = methodPreset("default").topology.relative_offset;
-  double relative_sigma_floor = methodPreset("default").topology.relative_sigma_floor;
-  double histogram_weight = -1.0;  ///< -1: the preset's
-  int histogram_gate = -1;         ///< -1: the preset's
-  CLI::Option* likelihood_given = nullptr;
-  CLI::Option* slope_given = nullptr;
-  CLI::Option* offset_given = nullptr;
-  bool new_node_entropy = methodPreset("default").topology.new_node_entropy;
-  CLI::Option* entropy_given = nullptr;
-  CLI::Option* floor_given = nullptr;
-  double new_node_probability = methodPreset("default").topology.new_node_probability;
-  CLI::Option* new_node_probability_given = nullptr;
-  double new_node_likelihood_floor = methodPreset("default").topology.new_node_likelihood_floor;
-  CLI::Option* new_node_floor_given = nullptr;
+  bool json = false;   ///< --json: the summary as one JSON object on stdout
+  bool quiet = false;  ///< --quiet: no progress and no per-place lines on stderr
+  int loop_min_gap = 10;  ///< frame-level loop closures by visits: detections at least this many frames back
 };
 
 double msSince(std::chrono::steady_clock::time_point start) {
@@ -127,66 +101,38 @@ MapLock lockRunFolderMap(const fs::path& map_path, const std::string& out) {
 }
 
 /// What a map made by this run records: the keys toposlamd records (the key table's recorded_in_map, read
-/// from the settings this run uses), the keypoint backend and the first source; so that toposlamd (and
-/// --resume) can tell a map made with other settings (`--preset thesis` against the default).
-MapSettings mapSettingsOf(const VpackConfig& vpack, const NgramSimilarityConfig& similarity,
-                          const FiedlerSegmenterConfig& segmenter, const TopologyFilterConfig& filter,
-                          const SequenceEvidenceConfig& evidence, const std::string& source_uri) {
-  DaemonConfig config;
-  config.fingerprint = vpack;
-  config.similarity = similarity;
-  config.segmentation = segmenter;
-  config.segmentation_stage.motion = MotionGateConfig{};  // the offline run's motion gate
+/// from the settings this run uses, with the filter's `filter`), the keypoint backend and the first source;
+/// so that toposlamd (and --resume) can tell a map made with other settings (`--preset thesis` against the
+/// default).
+MapSettings mapSettingsOf(const DaemonConfig& run_config, const TopologyFilterConfig& filter,
+                          const std::string& source_uri) {
+  DaemonConfig config = run_config;
   config.topology = filter;
-  config.sequence_evidence = evidence;
-  MapSettings settings = fingerprintMapSettings(vpack);
+  MapSettings settings = fingerprintMapSettings(config.fingerprint);
   for (auto& [key, value] : mapDecisionSettings(config)) settings[key] = std::move(value);
   settings[kMapSourceKey] = sourceIdentity(source_uri);
   return settings;
 }
 
-/// The preset's VPACK settings with --keypoints and --max-keypoints.
-VpackConfig fingerprintConfig(const MapOptions& o, const MethodPreset& preset) {
-  VpackConfig vpack = preset.fingerprint;
-  vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
-  if (o.max_keypoints >= 0) vpack.keypoints.setMaxKeypoints(o.max_keypoints);
-  return vpack;
-}
-
-/// How frame-level loop closures are found (docs/topology.md): true by sequence, online (the per-frame
-/// answer toposlamd publishes; SequenceEvidenceConfig::frame_revisits), false by visits to a node of the
-/// final topology. The thesis has no frame-level detector of its own: its preset reads them off the topology.
-bool framesBySequence(const MapOptions& o, const MethodPreset& preset) {
-  return o.frame_loops_given->count() > 0 ? o.frame_loops == "sequence" : preset.sequence_evidence.frame_revisits;
-}
-
-/// The preset's similarity with --histogram-weight and --histogram-gate.
-NgramSimilarityConfig similarityConfig(const MapOptions& o, const MethodPreset& preset) {
-  NgramSimilarityConfig config = preset.similarity;
-  if (o.histogram_weight >= 0) config.histogram_weight = o.histogram_weight;
-  if (o.histogram_gate >= 0) config.histogram_gate = o.histogram_gate == 1;
-  return config;
-}
-
-/// The topology stage the run starts from: a new filter, or the one of the map given to --resume with the
-/// origins of its observations.
+/// Where the run's observations come from: per observation so far (a resumed map's), then this run's.
 struct StartingFilter {
-  std::unique_ptr<ParticleFilterTopologyStage> topology;
   MapApplicationData origins;  ///< per observation so far (the resumed map's), then this run's
   int run_number = 0;          ///< this run's, in the origins
 };
 
-/// --resume: the saved map, refused (ConfigError naming the option that would accept it) when it was made
-/// with other keypoints, from another source, or with other settings (`settings_for(uri)`: what this run
-/// records for a source).
-StartingFilter resumedFilter(const MapOptions& o, const NgramSimilarity& similarity, const Clock& clock,
-                             bool filter_options_given,
+/// --resume: the saved map replaces the topology stage's new filter (its settings with it; the stage's
+/// candidate selection stays this run's); refused (ConfigError naming the option that would accept it)
+/// when it was made with other keypoints, from another source, or with other settings (`settings_for(uri)`:
+/// what this run records for a source).
+StartingFilter resumedFilter(const MapOptions& o, ParticleFilterTopologyStage& topology,
+                             const NgramSimilarity& similarity,
                              const std::function<MapSettings(const std::string&)>& settings_for) {
-  if (filter_options_given) {
-    throw std::invalid_argument(
-        "map: --particles, --alpha, --seed and --max-representatives come from the map "
-        "when resuming; drop them or start a new map");
-  }
+  for (const char* key : {"topology.particles", "topology.alpha", "topology.seed", "topology.max_representatives_per_node"})
+    if (keyGiven(o.config, key))
+      throw std::invalid_argument(
+          "map: --particles, --alpha, --seed and --max-representatives (topology.particles, topology.alpha, "
+          "topology.seed, topology.max_representatives_per_node) come from the map when resuming; drop them or "
+          "start a new map");
   LoadedMap loaded = MapStore::load(o.resume, similarity);
   // ORB descriptors mean nothing to a SIFT run (and so on), and another source (a simulated office, a
   // camera elsewhere) or other settings are no continuation unless the user says so: the map says what
@@ -215,61 +161,19 @@ StartingFilter resumedFilter(const MapOptions& o, const NgramSimilarity& similar
   if (unrecorded)
     std::cerr << "map: warning: " << o.resume << " records the keypoints and the source only (it was made by an older "
               << "toposlam): its other settings cannot be compared; continuing it with this run's\n";
-  TopologyFilterConfig config = loaded.filter->config();
-  config.candidates = o.candidates;  // how this run compares, not saved with the map (adoptMap applies it)
   StartingFilter start;
-  start.topology =
-      std::make_unique<ParticleFilterTopologyStage>(config, similarity, clock, TopologyStageConfig{});
   start.origins = decodeMapApplicationData(loaded.application_data, loaded.filter->observationCount());
-  start.topology->adoptMap(std::move(loaded));
+  topology.adoptMap(std::move(loaded));
   for (const auto& origin : start.origins.origins) start.run_number = std::max(start.run_number, origin.run + 1);
   start.run_number = std::max(start.run_number, static_cast<int>(start.origins.run_frames.size()));
-  std::cerr << "map: resumed " << o.resume << " (" << start.topology->observations() << " places)\n";
+  std::cerr << "map: resumed " << o.resume << " (" << topology.observations() << " places)\n";
   return start;
-}
-
-/// The filter config of a new map: the preset's, with the filter options given.
-TopologyFilterConfig newFilterConfig(const MapOptions& o, const MethodPreset& preset) {
-  TopologyFilterConfig config = preset.topology;
-  config.particles = o.particles;
-  config.alpha = o.alpha;
-  config.seed = o.seed;
-  config.max_representatives_per_node = o.max_representatives;
-  if (o.likelihood_given->count() > 0) config.likelihood = parseLikelihoodModel(o.likelihood);
-  if (o.slope_given->count() > 0) config.relative_slope = o.relative_slope;
-  if (o.offset_given->count() > 0) config.relative_offset = o.relative_offset;
-  if (o.entropy_given->count() > 0) config.new_node_entropy = o.new_node_entropy;
-  if (o.floor_given->count() > 0) config.relative_sigma_floor = o.relative_sigma_floor;
-  if (o.new_node_probability_given->count() > 0) config.new_node_probability = o.new_node_probability;
-  if (o.new_node_floor_given->count() > 0) config.new_node_likelihood_floor = o.new_node_likelihood_floor;
-  config.candidates = o.candidates;
-  if (const std::string problem = config.validate(); !problem.empty())
-    throw std::invalid_argument("map: " + problem);
-  return config;
-}
-
-/// A new filter: the preset's, with the filter options given.
-StartingFilter newFilter(const MapOptions& o, const MethodPreset& preset, const NgramSimilarity& similarity,
-                         const Clock& clock) {
-  StartingFilter start;
-  start.topology = std::make_unique<ParticleFilterTopologyStage>(newFilterConfig(o, preset), similarity, clock,
-                                                                 TopologyStageConfig{});
-  return start;
-}
-
-/// The filter's sequence evidence (docs/topology.md) from the --sequence-evidence options.
-SequenceEvidenceConfig sequenceEvidenceConfig(const MapOptions& o, bool by_sequence) {
-  SequenceEvidenceConfig evidence = o.sequence;
-  evidence.frame_revisits = by_sequence;
-  if (const std::string problem = evidence.validate(); !problem.empty())
-    throw std::invalid_argument("map: " + problem);
-  return evidence;
 }
 
 /// What the sources' traversals leave besides the runner's rows.
 struct Traversals {
   std::vector<TimingRow> timing;  ///< per segmented frame
-  std::int64_t refused = 0;       ///< frames the extractor refused
+  FrameFailures refused;          ///< frames the stages refused (frame_failures.hpp)
   /// Every segmented frame's fingerprint (run numbering), for the frame-level loop closures by visits at the
   /// end; empty by sequence (each frame's answer came online).
   std::vector<std::shared_ptr<const Fingerprint>> frame_fingerprints;
@@ -349,10 +253,11 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
       std::shared_ptr<const Fingerprint> fingerprint;
       try {
         fingerprint = runner.fingerprint(frame->image, frame->grey);
-      } catch (const std::invalid_argument& e) {
-        // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
-        if (done.refused++ == 0)
-          std::cerr << "map: skipping frame '" << frame->name << "': " << e.what() << "\n";
+      } catch (const std::exception& e) {
+        // A frame the stages refuse (empty, too small): skipped and counted, as toposlamd does.
+        if (done.refused.count())
+          std::cerr << "map: skipping frame '" << frame->name << "' (" << done.refused.total() << " so far): "
+                    << e.what() << "\n";
         continue;
       }
       t.fingerprint_ms = msSince(start);
@@ -381,7 +286,7 @@ Traversals traverseSources(const MapOptions& o, OfflineRunner& runner,
 }
 
 /// settings.txt: what the run was made with, for the report's header (and a reader of the run folder).
-void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const MethodPreset& preset,
+void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const std::string& preset,
                       const VpackConfig& vpack, const FiedlerSegmenterConfig& segmenter_config,
                       const TopologyFilterConfig& topo, const SequenceEvidenceConfig& evidence) {
   const auto real = [](double v) {
@@ -409,7 +314,7 @@ void writeRunSettings(const fs::path& out_dir, const MapOptions& o, const Method
                 " scales), at least " + real(evidence.min_gap_s) + " s back, score at least " + real(evidence.min_score)
           : "visits, at least " + std::to_string(o.loop_min_gap) + " frames back";
   writeSettings(out_dir, {{"toposlam", TOPOSLAM_VERSION},
-                          {"preset", preset.name},
+                          {"preset", preset},
                           {"keypoints", std::string(toString(vpack.keypoints.backend)) + ", at most " +
                                             std::to_string(vpack.keypoints.max_keypoints) + " per frame"},
                           {"segmentation.window", window},
@@ -612,10 +517,11 @@ void printSummary(const MapOptions& o, const SegmentationRun& all, std::size_t n
 }
 
 /// `toposlam map`: set up the stages, run every source through them, save the map, write the run folder.
-void runMap(const MapOptions& o, bool filter_options_given) {
+void runMap(const MapOptions& o) {
   if (o.sources.empty()) throw std::invalid_argument("map: give at least one SOURCE (e.g. images:DIR)");
-  FiedlerSegmenterConfig segmenter_config = segmenterConfig(o.segmentation, "map");  // --window-m: openMotion
-  std::optional<MotionReplay> motion = openMotion(o.motion, o.sources.size(), "map", segmenter_config);
+  DaemonConfig config = commandConfig(o.config);
+  std::optional<MotionReplay> motion = openMotion(o.motion, o.sources.size(), "map", config.segmentation);
+  const FiedlerSegmenterConfig& segmenter_config = config.segmentation;
   const fs::path out_dir(o.out);
   createRunFolder(o.out);
   const fs::path map_path = out_dir / "map.tsm";
@@ -626,47 +532,43 @@ void runMap(const MapOptions& o, bool filter_options_given) {
   }
   const MapLock map_lock = lockRunFolderMap(map_path, o.out);
 
-  const MethodPreset preset = presetOf(o.segmentation, "map");
-  const VpackConfig vpack = fingerprintConfig(o, preset);
-  VpackFingerprintStage fingerprint_stage(vpack, nullptr);  // no thumbnails: no place events offline
-  const NgramSimilarity similarity(similarityConfig(o, preset));
-
   // The filter steps run to their end before the next frame, so the budget's clock is never read for a
   // decision (ParticleFilterTopologyStage::advance with an infinite budget).
   const ManualClock clock;
-  const SequenceEvidenceConfig evidence = sequenceEvidenceConfig(o, framesBySequence(o, preset));
-  const NgramSimilarityConfig similarity_config = similarityConfig(o, preset);
-  const auto settings_for = [&](const std::string& uri) {
-    return mapSettingsOf(vpack, similarity_config, segmenter_config, newFilterConfig(o, preset), evidence, uri);
-  };
-  StartingFilter start = o.resume.empty() ? newFilter(o, preset, similarity, clock)
-                                          : resumedFilter(o, similarity, clock, filter_options_given, settings_for);
-  ParticleFilterTopologyStage& topology = *start.topology;
+  // toposlamd's stages (stage_assembly.hpp), on this thread; no thumbnails: no place events offline.
+  StageAssembly stages(config, clock, nullptr, Thumbnails::None);
+  const VpackConfig& vpack = config.fingerprint;
+  const NgramSimilarity& similarity = stages.similarity();
+  const SequenceEvidenceConfig& evidence = config.sequence_evidence;
+  ParticleFilterTopologyStage& topology = stages.topology();
+  const auto settings_for = [&](const std::string& uri) { return mapSettingsOf(config, config.topology, uri); };
+  StartingFilter start;
+  if (!o.resume.empty()) start = resumedFilter(o, topology, similarity, settings_for);
   const TopologyParticleFilter& filter = topology.filter();
   const int first_observation = filter.observationCount();
 
   // Thumbnails are the daemon's (place events); the offline run keeps none.
-  FiedlerSegmentationStage segmentation_stage(segmenter_config, similarity, 1, MotionGateConfig{}, evidence);
-  OfflineRunner runner(fingerprint_stage, segmentation_stage, &topology);
+  FiedlerSegmentationStage& segmentation_stage = stages.segmentation();
+  OfflineRunner runner(stages.fingerprint(), segmentation_stage, &topology);
   Traversals traversals =
       traverseSources(o, runner, segmentation_stage, motion, start.origins, start.run_number,
                       !evidence.frame_revisits);
   if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "map") << "\n";
   const SegmentationRun& all = runner.run();
   if (all.frames.empty())
-    throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(traversals.refused) +
+    throw std::runtime_error("map: the sources gave no usable frames (" + std::to_string(traversals.refused.total()) +
                              " refused)");
   // The map first: it is the run's work and what --resume continues. A report file that cannot be
   // written afterwards (a full disk) is still an error, but no longer takes the map down with it.
-  const MapSettings made_with = mapSettingsOf(vpack, similarity_config, segmenter_config, filter.config(), evidence,
-                                              o.sources.front());  // the first traversal's source
+  const MapSettings made_with =
+      mapSettingsOf(config, filter.config(), o.sources.front());  // the first traversal's source
   finishRunOrigins(start.origins, start.run_number, all);
   MapStore::save(map_path, filter, encodeMapApplicationData(start.origins), made_with);
 
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter.estimate(3);
   const std::vector<std::int64_t> place_nodes = runner.placeNodes();
-  writeRunSettings(out_dir, o, preset, vpack, segmenter_config, filter.config(), evidence);
+  writeRunSettings(out_dir, o, config.preset, vpack, segmenter_config, filter.config(), evidence);
   {
     std::vector<std::string> uris;
     for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
@@ -702,110 +604,46 @@ void addMapCommand(CLI::App& app) {
   cmd->add_option("--out", options->out, "Output run folder")->required();
   cmd->add_flag("--json", options->json, "Print the summary as one JSON object (frames, places, nodes, probabilities)");
   cmd->add_flag("--quiet", options->quiet, "No progress and no per-place lines on stderr (warnings and errors stay)");
-  auto* particles = cmd->add_option("--particles", options->particles, "Particles (thesis: 500)")
-                        ->check(keyRange("topology.particles"))
-                        ->capture_default_str();
-  auto* alpha = cmd->add_option("--alpha", options->alpha, "Prior map size of eq. 5.8 (thesis: 15)")
-                    ->capture_default_str();
-  auto* seed = cmd->add_option("--seed", options->seed, "Seed of the filter's random generator")
-                   ->capture_default_str();
-  options->frame_loops_given =
-      cmd->add_option("--frame-loops", options->frame_loops,
-                      "Frame-level loop closures in frames.csv: sequence (evidence of a run of keyframes, "
-                      "docs/topology.md) or visits (the earlier visits of each frame's node; the thesis "
-                      "preset's default)")
-          ->check(CLI::IsMember({"sequence", "visits"}))
-          ->capture_default_str();
+  addConfigOptions(*cmd, options->config);
+  addSegmentationOptions(*cmd, options->config);
+  ConfigOptions& c = options->config;
+  addKeyAlias(*cmd, c, "--particles", "topology.particles");
+  addKeyAlias(*cmd, c, "--alpha", "topology.alpha");
+  addKeyAlias(*cmd, c, "--seed", "topology.seed");
+  addKeyAlias(*cmd, c, "--max-representatives", "topology.max_representatives_per_node");
+  addKeyAlias(*cmd, c, "--likelihood", "topology.likelihood");
+  addKeyAlias(*cmd, c, "--relative-slope", "topology.relative_slope");
+  addKeyAlias(*cmd, c, "--relative-offset", "topology.relative_offset");
+  addKeyAlias(*cmd, c, "--relative-sigma-floor", "topology.relative_sigma_floor");
+  addKeyAlias(*cmd, c, "--new-node-entropy", "topology.new_node_entropy");
+  addKeyAlias(*cmd, c, "--new-node-probability", "topology.new_node_probability");
+  addKeyAlias(*cmd, c, "--new-node-likelihood-floor", "topology.new_node_likelihood_floor");
+  addKeyAlias(*cmd, c, "--exhaustive-up-to", "topology.candidates.exhaustive_up_to");
+  addKeyAlias(*cmd, c, "--candidates", "topology.candidates.candidates");
+  addKeyAlias(*cmd, c, "--frame-loops", {"topology.sequence_evidence.frame_revisits"},
+              {{"sequence", "true"}, {"visits", "false"}},
+              "= --set topology.sequence_evidence.frame_revisits=true (sequence) or false (visits): frame-level loop "
+              "closures in frames.csv by the sequence detector, online (docs/topology.md), or by the earlier visits "
+              "of each frame's node (the thesis preset's)");
+  addKeyAlias(*cmd, c, "--loop-min-gap-s", "topology.sequence_evidence.min_gap_s");
+  addKeyAlias(*cmd, c, "--loop-memory-s", "topology.sequence_evidence.memory_s");
+  addKeyAlias(*cmd, c, "--loop-scales", "topology.sequence_evidence.scales");
+  addKeyAlias(*cmd, c, "--keyframe-interval-s", "topology.sequence_evidence.keyframe_interval_s");
+  addKeyAlias(*cmd, c, "--loop-min-margin", "topology.sequence_evidence.min_margin");
+  addKeyAlias(*cmd, c, "--loop-distinct-s", "topology.sequence_evidence.distinct_s");
+  addKeyAlias(*cmd, c, "--sequence-evidence", "topology.sequence_evidence.weight");
+  addKeyAlias(*cmd, c, "--sequence-evidence-min-score", "topology.sequence_evidence.min_score");
+  addKeyAlias(*cmd, c, "--sequence-evidence-min-relative", "topology.sequence_evidence.min_relative");
+  addKeyAlias(*cmd, c, "--sequence-evidence-min-share", "topology.sequence_evidence.min_share");
+  addKeyAlias(*cmd, c, "--max-keypoints", "fingerprint.keypoints.max_keypoints");
+  addKeyAlias(*cmd, c, "--histogram-weight", "similarity.histogram_weight");
+  addKeyAlias(*cmd, c, "--histogram-gate", {"similarity.histogram_gate"}, {{"1", "true"}, {"0", "false"}},
+              "= --set similarity.histogram_gate=true (1) or false (0): histograms as a gate or a weighted part");
   cmd->add_option("--loop-min-gap", options->loop_min_gap,
-                  "Frame-level loop closures (visits): detections at least this many frames back")
+                  "Frame-level loop closures by visits (--frame-loops visits): detections at least this many frames "
+                  "back")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--loop-min-gap-s", options->sequence.min_gap_s,
-                  "Frame-level loop closures (sequence): detections at least this many seconds back")
-      ->capture_default_str()
-      ->check(keyRange("topology.sequence_evidence.min_gap_s"));
-  cmd->add_option("--loop-memory-s", options->sequence.memory_s,
-                  "Frame-level loop closures (sequence): the longest memory of the run of matches, seconds")
-      ->capture_default_str()
-      ->check(keyRange("topology.sequence_evidence.memory_s"));
-  cmd->add_option("--loop-scales", options->sequence.loop.scales,
-                  "Frame-level loop closures (sequence): memories side by side, each 4 times shorter")
-      ->capture_default_str()
-      ->check(keyRange("topology.sequence_evidence.scales"));
-  cmd->add_option("--keyframe-interval-s", options->sequence.loop.keyframe_interval_s,
-                  "Frame-level loop closures (sequence): one keyframe at most this often")
-      ->capture_default_str()
-      ->check(keyRange("topology.sequence_evidence.keyframe_interval_s"));
-  cmd->add_option("--sequence-evidence", options->sequence.weight,
-                  "Filter: likelihood of an earlier place that every keyframe of the new place detects into (the "
-                  "sequence detector's evidence, docs/topology.md; 0 = off, as in the thesis)")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  cmd->add_option("--sequence-evidence-min-score", options->sequence.min_score,
-                  "The detection score (standard deviations of its noise) a frame's match needs to be published, "
-                  "and a keyframe's evidence to count")
-      ->check(keyRange("topology.sequence_evidence.min_score"))
-      ->capture_default_str();
-  cmd->add_option("--loop-min-margin", options->sequence.min_margin,
-                  "Frame-level loop closures (sequence): how far (standard deviations) a published match's run must "
-                  "stand out from every other run")
-      ->capture_default_str()
-      ->check(keyRange("topology.sequence_evidence.min_margin"));
-  cmd->add_option("--loop-distinct-s", options->sequence.distinct_s,
-                  "Frame-level loop closures (sequence): runs ending within this many seconds of the best are its own")
-      ->capture_default_str()
-      ->check(keyRange("topology.sequence_evidence.distinct_s"));
-  cmd->add_option("--sequence-evidence-min-relative", options->sequence.min_relative,
-                  "Filter: the keyframe's own relative similarity z with its detection needed for its evidence to count")
-      ->check(CLI::Range(-1e6, 1e6))
-      ->capture_default_str();
-  cmd->add_option("--sequence-evidence-min-share", options->sequence.min_share,
-                  "Filter: the share of the new place's keyframes an earlier place needs before it gets evidence")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  cmd->add_option("--max-keypoints", options->max_keypoints, "Keypoints per frame (default: the preset's)")
-      ->check(CLI::Range(1, 10000));
-  cmd->add_option("--histogram-weight", options->histogram_weight, "Similarity: weight of the histogram part (default: the preset's)");
-  cmd->add_option("--histogram-gate", options->histogram_gate, "Similarity: histograms as a gate (1) or a weighted part (0)");
-  options->likelihood_given =
-      cmd->add_option("--likelihood", options->likelihood, "Filter likelihood: relative (per query) or absolute (thesis)")
-          ->capture_default_str();
-  options->slope_given =
-      cmd->add_option("--relative-slope", options->relative_slope, "Relative likelihood: logistic slope per z unit")
-          ->capture_default_str();
-  options->offset_given =
-      cmd->add_option("--relative-offset", options->relative_offset, "Relative likelihood: z at which it is 1/2")
-          ->capture_default_str();
-  options->entropy_given =
-      cmd->add_option("--new-node-entropy", options->new_node_entropy,
-                      "Filter: a new node's likelihood is eta (1 - max L), eta eq. 5.7's entropy (true, thesis), "
-                      "or 1 - max L (false; docs/topology.md)")
-          ->capture_default_str();
-  options->floor_given = cmd->add_option("--relative-sigma-floor", options->relative_sigma_floor,
-                                         "Relative likelihood: smallest spread of the other similarities")
-                             ->capture_default_str();
-  options->new_node_probability_given =
-      cmd->add_option("--new-node-probability", options->new_node_probability,
-                      "Filter: probability of a new node from a known one, (0, 1) (thesis: 0.05)")
-          ->capture_default_str();
-  options->new_node_floor_given =
-      cmd->add_option("--new-node-likelihood-floor", options->new_node_likelihood_floor,
-                      "Filter: smallest likelihood of a new node (perceptual aliasing), [0, 1) (thesis: 0; "
-                      "docs/topology.md, \"Look-alike rooms\")")
-          ->capture_default_str();
-  cmd->add_option("--exhaustive-up-to", options->candidates.exhaustive_up_to,
-                  "A new place is compared with every stored representative up to this many; above, with the "
-                  "candidate index's top only (docs/topology.md, \"Large maps\")")
-      ->check(CLI::Range(0, 1000000000))
-      ->capture_default_str();
-  cmd->add_option("--candidates", options->candidates.candidates,
-                  "Above --exhaustive-up-to: stored representatives compared exactly from the index's top")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  auto* reps = cmd->add_option("--max-representatives", options->max_representatives,
-                               "Representatives kept per node (oldest dropped)")
-                   ->check(keyRange("topology.max_representatives_per_node"))
-                   ->capture_default_str();
   cmd->add_option("--resume", options->resume, "Continue the map in this map.tsm");
   cmd->add_flag("--resume-other-source", options->resume_other_source,
                 "With --resume: continue a map made from another source (refused otherwise)")
@@ -814,14 +652,8 @@ void addMapCommand(CLI::App& app) {
                 "With --resume: continue a map made with other settings (preset, segmentation, similarity, ...; "
                 "refused otherwise). The keypoints must agree; the filter's settings come from the map")
       ->needs("--resume");
-  cmd->add_option("--keypoints", options->keypoints, "VPACK keypoints: orb, sift, brisk, akaze")
-      ->capture_default_str();
-  addSegmentationOptions(*cmd, options->segmentation);
   addMotionOptions(*cmd, options->motion);
-  cmd->callback([options, particles, alpha, seed, reps] {
-    const bool filter_options_given = particles->count() + alpha->count() + seed->count() + reps->count() > 0;
-    runMap(*options, filter_options_given);
-  });
+  cmd->callback([options] { runMap(*options); });
 }
 
 }  // namespace toposlam::cli

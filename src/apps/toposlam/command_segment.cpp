@@ -24,6 +24,9 @@
 #include "toposlam/platform/thread_os.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/offline_runner.hpp"
+#include "toposlam/pipeline/clock.hpp"
+#include "toposlam/pipeline/frame_failures.hpp"
+#include "toposlam/pipeline/stage_assembly.hpp"
 #include "toposlam/run_folder/run_folder.hpp"
 #include "progress.hpp"
 #include "toposlam/core/json_writer.hpp"
@@ -35,9 +38,8 @@ namespace {
 struct SegmentOptions {
   std::string source;
   std::string out;
-  SegmentationOptions segmentation;
+  ConfigOptions config;  ///< -c, --set, --preset and the segmentation's aliases (config_options.hpp)
   MotionOptions motion;
-  std::string keypoints = "orb";
   std::int64_t max_frames = 0;
   int workers = 1;
   bool quiet = false;
@@ -45,27 +47,25 @@ struct SegmentOptions {
 };
 
 void runSegment(const SegmentOptions& o) {
-  FiedlerSegmenterConfig config = segmenterConfig(o.segmentation, "segment");
-  std::optional<MotionReplay> motion = openMotion(o.motion, 1, "segment", config);
-  const MethodPreset preset = presetOf(o.segmentation, "segment");
-  VpackConfig vpack = preset.fingerprint;
-  vpack.keypoints.backend = parseKeypointBackend(o.keypoints);
+  DaemonConfig settings = commandConfig(o.config);
+  std::optional<MotionReplay> motion = openMotion(o.motion, 1, "segment", settings.segmentation);
+  const FiedlerSegmenterConfig& config = settings.segmentation;
   createRunFolder(o.out);
 
   std::unique_ptr<FrameSource> source = openSource(o.source);
   std::unique_ptr<WorkerPool> pool;
   if (o.workers > 1) pool = std::make_unique<WorkerPool>(o.workers, namedWorkers("segment"));
-  VpackFingerprintStage fingerprint_stage(vpack, pool.get());
-  const NgramSimilarity similarity(preset.similarity);
-  // The daemon's stages without the topology one; thumbnails are the daemon's (place events), none here.
-  FiedlerSegmentationStage segmentation_stage(config, similarity, 1);
-  OfflineRunner pipeline(fingerprint_stage, segmentation_stage);
+  // toposlamd's stages (stage_assembly.hpp), the topology one unused; no thumbnails: no place events here.
+  const ManualClock clock;
+  StageAssembly stages(settings, clock, pool.get(), Thumbnails::None);
+  FiedlerSegmentationStage& segmentation_stage = stages.segmentation();
+  OfflineRunner pipeline(stages.fingerprint(), segmentation_stage);
 
   const std::int64_t total = source->frameCountHint();
   if (!o.quiet) std::cerr << "segment: " << source->describe() << "\n";
   std::vector<double> fingerprint_ms, segment_ms;
   std::vector<TimingRow> timing;
-  std::int64_t refused = 0;
+  FrameFailures failures;  // the one per-frame error policy (frame_failures.hpp)
   // The window's clock: the frames' timestamps with any step back cut out (the segmentation stage's;
   // docs/reliability.md, "Clock jumps"); frames.csv records it. Motion is looked up at the frame's own
   // timestamp (the motion file's clock is the recording's).
@@ -80,11 +80,12 @@ void runSegment(const SegmentOptions& o) {
     std::shared_ptr<const Fingerprint> fingerprint;
     try {
       fingerprint = pipeline.fingerprint(frame->image, frame->grey);
-    } catch (const std::invalid_argument& e) {
-      // A frame the extractor refuses (empty, too small) is skipped and counted, like a corrupt file.
+    } catch (const std::exception& e) {
+      // A frame the stages refuse (empty, too small): skipped and counted, as toposlamd does.
       progress.clearLine();
-      if (refused++ == 0)
-        std::cerr << "segment: skipping frame '" << frame->name << "': " << e.what() << "\n";
+      if (failures.count())
+        std::cerr << "segment: skipping frame '" << frame->name << "' (" << failures.total() << " so far): "
+                  << e.what() << "\n";
       continue;
     }
     fingerprint_ms.push_back(fingerprint_watch.elapsedMs());
@@ -96,6 +97,7 @@ void runSegment(const SegmentOptions& o) {
   }
   pipeline.finish();
   progress.finish();
+  const std::int64_t refused = failures.total();
   if (const FrameTimeline& timeline = segmentation_stage.sourceTimeline(); timeline.stepsBack() > 0)
     std::cerr << timelineSummary(timeline, "segment") << "\n";
   if (motion) std::cerr << motionSummary(segmentation_stage, o.motion, "segment") << "\n";
@@ -163,10 +165,9 @@ void addSegmentCommand(CLI::App& app) {
                   "Frame source URI: images:FOLDER_OR_GLOB, video:FILE, sim:WORLD?route=..., ...")
       ->required();
   cmd->add_option("--out", options->out, "Output run folder (created if missing)")->required();
-  addSegmentationOptions(*cmd, options->segmentation);
+  addConfigOptions(*cmd, options->config);
+  addSegmentationOptions(*cmd, options->config);
   addMotionOptions(*cmd, options->motion);
-  cmd->add_option("--keypoints", options->keypoints, "Keypoint backend: orb, sift, brisk, akaze")
-      ->capture_default_str();
   cmd->add_option("--max-frames", options->max_frames, "Stop after this many frames (0: whole stream)");
   cmd->add_option("--workers", options->workers, "Threads for the fingerprint's subregions")
       ->capture_default_str()

@@ -1,6 +1,6 @@
 // Shared pieces of the offline commands (`segment`, `map`, and the other commands' output files): opening
 // the frame source, creating output files with an actionable error, and the one block of segmentation
-// options `segment` and `map` take (defaults from FiedlerSegmenterConfig). The run folder's files are
+// options `segment` and `map` take (aliases of the key table's keys). The run folder's files are
 // run_folder's (toposlam/run_folder/run_folder.hpp).
 #pragma once
 
@@ -15,7 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/core/mat.hpp>
 
-#include "toposlam/config/method_preset.hpp"
+#include "config_options.hpp"
 #include "toposlam/core/frame_timeline.hpp"
 #include "toposlam/platform/output_file.hpp"
 #include "toposlam/pipeline/frame_source.hpp"
@@ -41,20 +41,9 @@ void writeImageFile(const std::filesystem::path& path, const cv::Mat& image);
 /// stepped back (docs/reliability.md, "Clock jumps").
 std::string timelineSummary(const FrameTimeline& timeline, const std::string& command);
 
-/// --preset plus --window-s, --window, --min-window-frames, --gamma, --delta, --similarity-floor,
-/// --min-keypoints, --cut: the preset gives every stage's defaults, an option given overrides its key.
-struct SegmentationOptions {
-  std::string preset = "default";
-  FiedlerSegmenterConfig config;  ///< bound to the options; only those given are used
-  std::string cut;
-  std::string representative;
-  std::vector<std::pair<CLI::Option*, int>> given;  ///< option and which key it sets (offline_run_io.cpp)
-};
-void addSegmentationOptions(CLI::App& command, SegmentationOptions& options);
-/// The method preset named by --preset (every stage's settings).
-MethodPreset presetOf(const SegmentationOptions& options, const std::string& command);
-/// The preset's segmenter config with the given options applied, validated; throws
-/// std::invalid_argument "<command>: <key>: <problem>".
-FiedlerSegmenterConfig segmenterConfig(const SegmentationOptions& options, const std::string& command);
+/// The segmentation's aliases (--window-s, --window, --min-window-frames, --gamma, --delta, --similarity-floor,
+/// --min-keypoints, --cut, --doorway-shift-s, --doorway-borders, --representative, --representative-interval-s,
+/// --place-samples) and --keypoints, shared by `segment` and `map`: each sets its key (config_options.hpp).
+void addSegmentationOptions(CLI::App& command, ConfigOptions& options);
 
 }  // namespace toposlam::cli

@@ -39,6 +39,7 @@
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/map_files.hpp"
 #include "toposlam/pipeline/pipeline.hpp"
+#include "toposlam/pipeline/stage_assembly.hpp"
 #include "toposlam/pipeline/thread_table.hpp"
 #include "toposlam/platform/file_system.hpp"
 #include "toposlam/platform/lcm_transport.hpp"
@@ -91,27 +92,18 @@ std::function<void(int)> fingerprintWorkers(const ThreadSettings& fingerprint) {
   };
 }
 
-/// Everything one run needs, built from the config in dependency order.
+/// Everything one run needs: the source, the fingerprint's worker pool and the stages (the one assembly the
+/// offline commands use too, stage_assembly.hpp).
 struct Assembly {
   std::unique_ptr<FrameSource> source;
   std::unique_ptr<WorkerPool> pool;
-  std::unique_ptr<VpackFingerprintStage> fingerprint;
-  std::unique_ptr<NgramSimilarity> similarity;
-  std::unique_ptr<FiedlerSegmentationStage> segmentation;
-  std::unique_ptr<ParticleFilterTopologyStage> topology;
+  StageAssembly stages;
 
-  Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri) {
-    source = openSource(source_uri);
-    pool = std::make_unique<WorkerPool>(config.fingerprint_stage.workers,
-                                        fingerprintWorkers(config.pipeline.threads.fingerprint));
-    fingerprint = std::make_unique<VpackFingerprintStage>(config.fingerprint, pool.get(),
-                                                          config.fingerprint_stage.thumbnail_width);
-    similarity = std::make_unique<NgramSimilarity>(config.similarity);
-    segmentation = std::make_unique<FiedlerSegmentationStage>(config.segmentation, *similarity, 600,
-                                                               config.segmentation_stage.motion, config.sequence_evidence);
-    topology = std::make_unique<ParticleFilterTopologyStage>(config.topology, *similarity, clock,
-                                                             config.topology_stage);
-  }
+  Assembly(const DaemonConfig& config, const Clock& clock, const std::string& source_uri)
+      : source(openSource(source_uri)),
+        pool(std::make_unique<WorkerPool>(config.fingerprint_stage.workers,
+                                          fingerprintWorkers(config.pipeline.threads.fingerprint))),
+        stages(config, clock, pool.get(), Thumbnails::Kept) {}
 };
 
 /// Until the host has a route to LCM's multicast group (lcm.open_retry_s apart): a service started before
@@ -335,29 +327,29 @@ int runDaemon(const DaemonConfig& config) {
   // What the map records (and saves) as made with: every setting that changes what the mapping decides,
   // the keypoint backend and this run's source.
   MapSettings map_settings = mapSettingsOf(config);
-  parts.topology->setMapSettings(map_settings);
+  parts.stages.topology().setMapSettings(map_settings);
   FrameSource& named_source = *parts.source;
-  parts.topology->nameFramesWith([&named_source](std::int64_t sequence) { return named_source.frameName(sequence); });
+  parts.stages.topology().nameFramesWith([&named_source](std::int64_t sequence) { return named_source.frameName(sequence); });
   if (config.map.load_at_start && !map_config.path.empty()) {
     // The newest file that loads: the map, else its .prev; a file that does not load is kept aside for a
     // human under a timestamped name (never over an earlier one) and the robot starts from what is left.
     const auto max_bytes = static_cast<std::uint64_t>(config.map.max_mb * 1024.0 * 1024.0);
-    RecoveredMap recovered = MapStore::recover(map_config.path, *parts.similarity, max_bytes);
+    RecoveredMap recovered = MapStore::recover(map_config.path, parts.stages.similarity(), max_bytes);
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
       const MapSettings recorded = recovered.map->settings;
       const bool other_source = checkResumable(recorded, map_settings, config.map, recovered.loaded_from.string());
-      parts.topology->adoptMap(std::move(*recovered.map));
+      parts.stages.topology().adoptMap(std::move(*recovered.map));
       // From then on the map records this run's settings, with the filter's own from the map (they came
       // with it), and this source.
       DaemonConfig effective = config;
-      effective.topology = parts.topology->filter().config();
+      effective.topology = parts.stages.topology().filter().config();
       map_settings = mapSettingsOf(effective);
-      parts.topology->setMapSettings(map_settings);
+      parts.stages.topology().setMapSettings(map_settings);
       spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
-                   parts.topology->observations(),
+                   parts.stages.topology().observations(),
                    recovered.problems.empty() ? "" : ", the newest file that loads");
-      if (!other_source) continueSource(recorded, config, *parts.source, *parts.topology);
+      if (!other_source) continueSource(recorded, config, *parts.source, parts.stages.topology());
     } else if (!recovered.problems.empty()) {
       spdlog::error("toposlamd: no map file of {} loads; starting a new map", map_config.path);
     }
@@ -371,7 +363,7 @@ int runDaemon(const DaemonConfig& config) {
   MotionStatusCounters motion_status;
   std::atomic<bool> receiving{true};
   const LcmChannels channels = channelsOf(config.lcm);
-  FiedlerSegmentationStage& segmentation_stage = *parts.segmentation;
+  FiedlerSegmentationStage& segmentation_stage = parts.stages.segmentation();
   segmentation_stage.reportMotionTo(&motion_status);
   LcmSubscriber motion(config.lcm.url, channels, {channels.motion}, [&](const ReceivedMessage& m) {
     motion_status.messages.fetch_add(1);
@@ -381,8 +373,8 @@ int runDaemon(const DaemonConfig& config) {
   });
   LcmPipelineSink sink(config.lcm.url, channels, config.lcm.jpeg_quality, &motion_status);
 
-  Pipeline pipeline(config.pipeline, map_config, config.watchdog, *parts.source, *parts.fingerprint,
-                    *parts.segmentation, *parts.topology, sink, clock);
+  Pipeline pipeline(config.pipeline, map_config, config.watchdog, *parts.source, parts.stages.fingerprint(),
+                    parts.stages.segmentation(), parts.stages.topology(), sink, clock);
   if (config.pipeline.queues.overflow == QueueOverflow::Auto)
     spdlog::info("toposlamd: full queues {} (pipeline.queues.overflow auto: {})", toString(pipeline.overflow()),
                  pipeline.overflow() == QueueOverflow::Block

@@ -78,6 +78,12 @@ int main(int argc, char** argv) {
       if (o->key->path == path && o->option->count() > 0) return o.get();
     return nullptr;
   };
+  std::vector<std::string> sets;
+  app.add_option("--set", sets,
+                 "set any key of the config: --set KEY=VALUE (repeatable; keys and values as in the YAML, "
+                 "docs/config.md), applied after the file and the options above")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
   app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
   app.add_flag("--print-config", print_config,
                "print the effective config (file, defaults and options) as YAML with every key, and exit");
@@ -94,27 +100,18 @@ int main(int argc, char** argv) {
       toposlam::configureLogging("toposlamd", *toposlam::parseLogLevel(level_option ? level_option->text : "info"));
 
   try {
-    toposlam::DaemonConfig config;
     const bool explicit_config = !config_path.empty();
     if (!explicit_config) config_path = toposlam::defaultDaemonConfigPath();
-    if (explicit_config || std::filesystem::exists(config_path)) {
-      config = toposlam::loadDaemonConfig(config_path);
-    } else {
-      config_path = "(built-in defaults)";
-    }
-    bool options_given = false;
-    for (const auto& o : overrides) {
-      if (o->option->count() == 0) continue;
-      options_given = true;
-      try {
-        toposlam::setConfigValue(config, o->key->path, o->text);
-      } catch (const toposlam::ConfigError& e) {
-        throw toposlam::ConfigError("command line: " + o->key->option + ": " + e.what());
-      }
-    }
+    const bool read_file = explicit_config || std::filesystem::exists(config_path);
+    std::vector<toposlam::ConfigOverride> given_overrides;
+    for (const auto& o : overrides)
+      if (o->option->count() > 0) given_overrides.push_back({o->key->path, o->text, o->key->option});
+    for (const std::string& set : sets) given_overrides.push_back(toposlam::parseSetOverride(set));
+    const bool options_given = !given_overrides.empty();
+    const toposlam::DaemonConfig config =
+        toposlam::commandLineConfig(read_file ? config_path : std::string(), given_overrides);
+    if (!read_file) config_path = "(built-in defaults)";
     spdlog::default_logger()->set_level(*toposlam::parseLogLevel(config.log_level));
-    if (std::string problem = config.validate(); !problem.empty())
-      throw toposlam::ConfigError("command line: " + problem);
     if (print_config) {
       std::cout << "# toposlamd's effective config: " << config_path << (options_given ? " and the options" : "")
                 << "\n" << toposlam::configYaml(config, false);
