@@ -1,6 +1,8 @@
 """LiveViewState of `toposlam view` (src/apps/toposlam/view/live_view.py), fed encoded LCM messages
 directly: no sockets, no daemon. Run by ctest as test_live_view_state (PYTHONPATH: the build tree's
 toposlam_lcm and the view's folder)."""
+import json
+import math
 import unittest
 
 import toposlam_lcm
@@ -77,6 +79,21 @@ class LiveViewStateTest(unittest.TestCase):
         self.assertEqual(len(s["nodes"]), 1)  # still the first topology
         self.assertIsNone(s["place"])
         self.assertTrue(s["last_error"].startswith("status: "))
+
+    def test_given_nan_in_a_status_and_a_place_then_the_snapshot_is_still_json(self):
+        state = LiveViewState()
+        status = toposlam_lcm.status_t()
+        status.state, status.source_state, status.motion_state = "running", "simulator", "none"
+        status.fps, status.latency_median_ms, status.latency_p99_ms = 30.0, math.nan, math.inf
+        self.assertTrue(state.accept("status", status.encode()))
+        p = toposlam_lcm.place_t()
+        p.frame, p.place, p.node, p.probability, p.latency_ms, p.match_node = 3, -1, -1, math.nan, 1.5, -1
+        self.assertTrue(state.accept("place", p.encode()))
+        s = json.loads(json.dumps(state.snapshot(), allow_nan=False))
+        self.assertEqual((s["status"]["fps"], s["status"]["latency_median_ms"], s["status"]["latency_p99_ms"]),
+                         (30.0, None, None))
+        self.assertEqual((s["place"]["probability"], s["place"]["latency_ms"]), (None, 1.5))
+        self.assertEqual(s["current_node"], -1)
 
     def test_given_a_thumbnail_budget_then_the_oldest_thumbnails_go_first(self):
         state = LiveViewState(thumbnail_bytes_kept=250)

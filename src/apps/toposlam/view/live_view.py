@@ -23,6 +23,7 @@ import argparse
 import collections
 import errno
 import json
+import math
 import os
 import signal
 import socket
@@ -39,6 +40,11 @@ EVENTS_MIN_INTERVAL_S = 0.2  # at most 5 updates per second per page: place_t ar
 EVENTS_KEEPALIVE_S = 15.0  # an SSE comment when nothing changed, so proxies and browsers keep the stream
 REVISITS_SHOWN = 6
 THUMBNAIL_BYTES_KEPT = 64 << 20  # about 20,000 places of toposlamd's 1.4-3.4 kB thumbnails
+
+
+def finite(x):
+    """x, or None when it is NaN or infinite (JSON has neither; the page shows "-")."""
+    return x if math.isfinite(x) else None
 
 
 class LiveViewState:
@@ -99,12 +105,12 @@ class LiveViewState:
         self._lock.notify_all()
 
     def _on_place(self, p):
-        self._place = {"frame": p.frame, "place": p.place, "node": p.node, "probability": p.probability,
-                       "latency_ms": p.latency_ms, "match_frame": p.match_frame, "match_place": p.match_place,
+        self._place = {"frame": p.frame, "place": p.place, "node": p.node, "probability": finite(p.probability),
+                       "latency_ms": finite(p.latency_ms), "match_frame": p.match_frame, "match_place": p.match_place,
                        "match_node": p.match_node, "map_revision": p.map_revision}
 
     def _on_place_event(self, e):
-        event = {"place": e.place, "node": e.node, "is_new": bool(e.is_new), "probability": e.probability,
+        event = {"place": e.place, "node": e.node, "is_new": bool(e.is_new), "probability": finite(e.probability),
                  "first_frame": e.first_frame, "last_frame": e.last_frame,
                  "representative_frame": e.representative_frame, "map_revision": e.map_revision,
                  "thumbnail": e.jpeg_size > 0}
@@ -127,7 +133,7 @@ class LiveViewState:
 
     def _on_topology(self, t):
         self._topology = {
-            "map_revision": t.map_revision, "probability": t.probability, "particles": t.particles,
+            "map_revision": t.map_revision, "probability": finite(t.probability), "particles": t.particles,
             "current_node": t.current_node,
             "nodes": [{"id": n.id, "places": list(n.places), "representative_frames": list(n.representative_frames)}
                       for n in t.nodes],
@@ -135,12 +141,13 @@ class LiveViewState:
 
     def _on_status(self, s):
         self._status = {
-            "state": s.state, "uptime_s": s.uptime_s, "fps": s.fps, "frames_captured": s.frames_captured,
+            "state": s.state, "uptime_s": finite(s.uptime_s), "fps": finite(s.fps),
+            "frames_captured": s.frames_captured,
             "frames_published": s.frames_published, "frames_dropped": s.frames_dropped,
             "source_skipped": s.source_skipped, "source_state": s.source_state,
             "source_reconnects": s.source_reconnects, "source_dropped": s.source_dropped,
-            "latency_median_ms": s.latency_median_ms, "latency_p99_ms": s.latency_p99_ms,
-            "cpu_percent": s.cpu_percent, "places": s.places, "map_revision": s.map_revision,
+            "latency_median_ms": finite(s.latency_median_ms), "latency_p99_ms": finite(s.latency_p99_ms),
+            "cpu_percent": finite(s.cpu_percent), "places": s.places, "map_revision": s.map_revision,
             "motion_state": s.motion_state}
 
     # --- output (the HTTP threads)
@@ -181,7 +188,7 @@ class LiveViewState:
             return {
                 "version": self.version,
                 "map_revision": topology["map_revision"] if topology else -1,
-                "topology_probability": topology["probability"] if topology else 0.0,
+                "topology_probability": topology["probability"] if topology else None,
                 "particles": topology["particles"] if topology else 0,
                 "nodes": nodes, "edges": edges,
                 "current_node": current, "current_kind": current_kind,
@@ -254,7 +261,7 @@ class ViewRequestHandler(BaseHTTPRequestHandler):
         if path in ("/", "/index.html"):
             self._send(200, "text/html; charset=utf-8", self.server.page)
         elif path == "/state":
-            self._send(200, "application/json", json.dumps(state.snapshot()).encode())
+            self._send(200, "application/json", json.dumps(state.snapshot(), allow_nan=False).encode())
         elif path == "/events":
             self._events(state)
         elif path.startswith("/thumbnail/") and path.endswith(".jpg"):
@@ -287,7 +294,7 @@ class ViewRequestHandler(BaseHTTPRequestHandler):
                     self.wfile.write(b": keep-alive\n\n")
                 else:
                     sent = version
-                    self.wfile.write(b"data: " + json.dumps(state.snapshot()).encode() + b"\n\n")
+                    self.wfile.write(b"data: " + json.dumps(state.snapshot(), allow_nan=False).encode() + b"\n\n")
                 self.wfile.flush()
                 self.server.stop.wait(EVENTS_MIN_INTERVAL_S)
         except (BrokenPipeError, ConnectionResetError):
