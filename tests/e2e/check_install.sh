@@ -15,7 +15,8 @@ for f in usr/sbin/toposlamd usr/bin/toposlam usr/lib/systemd/system/toposlamd.se
          usr/share/toposlam/lcm/place_t.lcm usr/share/toposlam/lcm/motion_t.lcm usr/include/toposlam_lcm/place_t.hpp \
          usr/share/doc/toposlam/examples/50-toposlam-multicast.network etc/toposlam/toposlam-bridge.yaml \
          usr/lib/python3/dist-packages/toposlam_lcm/__init__.py usr/lib/python3/dist-packages/toposlam_lcm/udpm_reader.py \
-         usr/share/doc/toposlam/examples/python/listen_places.py usr/share/doc/toposlam/examples/cpp/listen_places.cpp; do
+         usr/share/doc/toposlam/examples/python/listen_places.py usr/share/doc/toposlam/examples/cpp/listen_places.cpp \
+         usr/share/toposlam/view/live_view.py usr/share/toposlam/view/live_view.html; do
   [ -e "$dest/pkg/$f" ] || fail "missing after install --prefix /usr: $f"
 done
 [ -z "$(find "$dest/pkg" -name __pycache__ -o -name '*.pyc')" ] || fail "install --prefix /usr wrote Python byte code"
@@ -49,10 +50,33 @@ if [ -e "$build/modules/toposlam-source-libcamera.so" ]; then
     || fail "the installed toposlam did not say the libcamera camera is missing"
 fi
 
+# The installed `toposlam view` runs the installed server with the installed toposlam_lcm (not the source
+# or build tree's) and serves its page (multicast or not: without a route it says it is waiting for one).
+if command -v python3 >/dev/null && command -v curl >/dev/null; then
+  port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  "$dest/pkg/usr/bin/toposlam" view --port "$port" --lcm-url "udpm://239.255.76.67:7667?ttl=0" >"$dest/view.log" 2>&1 &
+  view=$!
+  i=0
+  until curl -sf "http://127.0.0.1:$port/" -o "$dest/view.html"; do
+    i=$((i + 1))
+    [ $i -le 100 ] && kill -0 "$view" 2>/dev/null || { cat "$dest/view.log"; fail "the installed toposlam view did not serve its page"; }
+    sleep 0.1
+  done
+  tr '\0' ' ' <"/proc/$view/cmdline" | grep -q " $dest/pkg/usr/share/toposlam/view/live_view.py " \
+    || fail "the installed toposlam view did not run the installed live_view.py: $(tr '\0' ' ' <"/proc/$view/cmdline")"
+  tr '\0' '\n' <"/proc/$view/environ" | grep -q "^PYTHONPATH=$dest/pkg/usr/lib/python3/dist-packages" \
+    || fail "the installed toposlam view did not put the installed toposlam_lcm first on PYTHONPATH"
+  grep -q "toposlam live view" "$dest/view.html" || fail "the installed toposlam view served another page"
+  kill -TERM "$view"
+  rc=0; wait "$view" || rc=$?
+  [ $rc -eq 0 ] || fail "the installed toposlam view exited with $rc after SIGTERM"
+  [ -z "$(find "$dest/pkg" -name __pycache__)" ] || fail "the installed toposlam view wrote Python byte code"
+fi
+
 # 2. A private prefix: everything under it, the unit pointing at its binary.
 cmake --install "$build" --prefix "$dest/local" >/dev/null
 for f in sbin/toposlamd bin/toposlam lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
-         lib/python3/dist-packages/toposlam_lcm/place_t.py; do
+         lib/python3/dist-packages/toposlam_lcm/place_t.py share/toposlam/view/live_view.py; do
   [ -e "$dest/local/$f" ] || fail "missing after install --prefix P: P/$f"
 done
 grep -q "^ExecStart=$dest/local/sbin/toposlamd\$" "$dest/local/lib/systemd/system/toposlamd.service" \

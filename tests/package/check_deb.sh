@@ -33,7 +33,8 @@ for f in /usr/bin/toposlam /usr/sbin/toposlamd /usr/bin/toposlam-bridge /usr/bin
          /usr/share/man/man1/toposlam-bridge.1.gz /usr/lib/python3/dist-packages/toposlam_lcm/__init__.py \
          /usr/lib/python3/dist-packages/toposlam_lcm/place_t.py /usr/lib/python3/dist-packages/toposlam_lcm/topology_edge_t.py \
          /usr/lib/python3/dist-packages/toposlam_lcm/udpm_reader.py /usr/share/doc/toposlam/examples/python/listen_places.py \
-         /usr/share/doc/toposlam/examples/cpp/listen_places.cpp; do
+         /usr/share/doc/toposlam/examples/cpp/listen_places.cpp /usr/share/toposlam/view/live_view.py \
+         /usr/share/toposlam/view/live_view.html; do
   grep -qx "$f" "$tmp/files" || fail "the package has no $f (man pages need help2man: scripts/setup.sh)"
 done
 if grep -E '^/usr/local/|^/usr/etc/' "$tmp/files"; then fail "files outside the FHS paths of a package"; fi

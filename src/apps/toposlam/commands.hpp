@@ -23,5 +23,7 @@ void addRecognitionCommand(CLI::App& app);
 /// `toposlam map-info MAP` and `toposlam export MAP --out DIR` (command_map_info.cpp).
 void addMapInfoCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
+/// `toposlam view`: the live web view of toposlamd's LCM messages (command_view.cpp, view/live_view.py).
+void addViewCommand(CLI::App& app);
 
 }  // namespace toposlam::cli

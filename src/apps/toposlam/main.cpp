@@ -1,5 +1,5 @@
 // toposlam: the offline command-line tool (fingerprint, similarity, localize, segment, map, sim, eval,
-// report, listen, config). Thin: it parses arguments, builds the objects and runs them. The benchmarks are
+// report, listen, config, view). Thin: it parses arguments, builds the objects and runs them. The benchmarks are
 // a program of their own, toposlam-bench (bench/); `toposlam bench` only says so (command_bench.cpp).
 //
 // Exit status (src/apps/common/cli_main.hpp): 0 ok, 1 runtime error, 2 usage or config error.
@@ -38,6 +38,7 @@ int run(int argc, char** argv) {
   toposlam::cli::addRecognitionCommand(app);
   toposlam::cli::addMapInfoCommand(app);
   toposlam::cli::addExportCommand(app);
+  toposlam::cli::addViewCommand(app);
   return toposlam::cli::runCommandLine(app, argc, argv, "toposlam");
 }
 
