@@ -203,7 +203,7 @@ std::vector<ConfigKey> makeKeys() {
                    "bound on all recordings under record.dir together; recording stops there, mapping goes on"));
   k.push_back(choice("record.format", AT(record.format), std::string("jpg"), std::vector<std::string>{"jpg", "png"},
                      "jpg, or png (lossless, about 5x larger)"));
-  k.push_back(integer("record.jpeg_quality", AT(record.jpeg_quality), 90, 1, 100, "", "JPEG quality of the recording"));
+  k.push_back(integer("record.jpeg_quality", AT(record.jpeg_quality), 95, 1, 100, "", "JPEG quality of the recording"));
   k.push_back(integer("record.queue_frames", AT(record.queue_frames), 16, 1, 1024, "frames",
                       "frames waiting for the writer before the oldest is dropped (counted)"));
   // Map.

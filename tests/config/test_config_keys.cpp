@@ -13,6 +13,7 @@
 
 #include "toposlam/config/config_keys.hpp"
 #include "toposlam/config/config_text.hpp"
+#include "toposlam/io/frame_recorder.hpp"
 #include "toposlam/config/daemon_config.hpp"
 
 using namespace toposlam;
@@ -272,4 +273,13 @@ SCENARIO("GIVEN a command-line value WHEN set by its key's path THEN it is read 
   CHECK(options == std::set<std::string>{"--source", "--log-level", "--lcm-url", "--map", "--no-map-load",
                                          "--resume-other-source", "--resume-other-settings", "--source-from-start",
                                          "--save-period", "--overflow", "--record"});
+}
+
+SCENARIO("GIVEN the daemon's recording and toposlam capture --record WHEN neither is configured THEN they record "
+         "at one JPEG quality") {
+  // Recorded frames must replay the way the live run saw them: the daemon's record.jpeg_quality (key table)
+  // and the recorder's own default (capture --record) were 90 and 95.
+  CHECK(std::get<long long>(daemonConfigKey("record.jpeg_quality").default_value) == FrameRecorderConfig{}.jpeg_quality);
+  CHECK(DaemonConfig{}.record.jpeg_quality == FrameRecorderConfig{}.jpeg_quality);
+  CHECK(std::get<std::string>(daemonConfigKey("record.format").default_value) == FrameRecorderConfig{}.format);
 }

@@ -96,7 +96,7 @@ topology: {particles: 200, seed: 42}
   CHECK(c.record.max_mb == 50.0);
   CHECK(c.record.format == "png");
   CHECK(c.record.queue_frames == 4);
-  CHECK(c.record.jpeg_quality == 90);
+  CHECK(c.record.jpeg_quality == 95);
 }
 
 SCENARIO("Bad configs are refused with the key's full name and the allowed range") {

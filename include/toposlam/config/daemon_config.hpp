@@ -48,7 +48,7 @@ struct RecordSettings {
   std::string dir;
   double max_mb = 1024;        ///< bound on all recordings under `dir` together, 1 .. 10000000 MB
   std::string format = "jpg";  ///< jpg or png (lossless, about 5x larger)
-  int jpeg_quality = 90;       ///< 1 .. 100
+  int jpeg_quality = 95;       ///< 1 .. 100 (toposlam capture --record's too)
   int queue_frames = 16;       ///< frames waiting for the writer before the oldest is dropped, 1 .. 1024
 };
 
