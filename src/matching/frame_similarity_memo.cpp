@@ -18,13 +18,14 @@ double FrameSimilarityMemo::symmetricSimilarity(const Fingerprint& a, const Fing
     ++computed_;
     return measure_.symmetricSimilarity(a, b);
   }
-  if (const auto found = with_newest_.find(&a); found != with_newest_.end()) {
-    ++remembered_;
-    return found->second;
-  }
+  for (auto it = with_newest_.rbegin(); it != with_newest_.rend(); ++it)
+    if (it->first == &a) {
+      ++remembered_;
+      return it->second;
+    }
   ++computed_;
   const double value = measure_.symmetricSimilarity(a, b);
-  with_newest_.emplace(&a, value);
+  with_newest_.emplace_back(&a, value);
   return value;
 }
 

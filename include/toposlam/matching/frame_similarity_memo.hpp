@@ -11,7 +11,8 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "toposlam/matching/similarity_measure.hpp"
 
@@ -38,7 +39,9 @@ class FrameSimilarityMemo : public SimilarityMeasure {
  private:
   const SimilarityMeasure& measure_;
   const Fingerprint* newest_ = nullptr;
-  mutable std::unordered_map<const Fingerprint*, double> with_newest_;
+  /// The frame's pairs in the order they were computed; its capacity is kept from frame to frame (no
+  /// allocation on the frame path once grown). Searched from the end: the segmenter asks for the latest frames.
+  mutable std::vector<std::pair<const Fingerprint*, double>> with_newest_;
   mutable std::int64_t computed_ = 0;
   mutable std::int64_t remembered_ = 0;
 };
