@@ -207,6 +207,17 @@ std::vector<ConfigKey> makeKeys() {
   k.push_back(integer("record.queue_frames", AT(record.queue_frames), 16, 1, 1024, "frames",
                       "frames waiting for the writer before the oldest is dropped (counted)"));
   // Map.
+  k.push_back(choice("map.mode", AT(map.mode), MapMode::Map, {{"map", MapMode::Map}, {"localize", MapMode::Localize}},
+                     "map (build the map, resuming it from map.path) or localize (localisation only: load the "
+                     "map at map.path, which must exist, and never change it; every frame gets the node it is "
+                     "in, or \"not a known node\"; docs/daemon.md, \"Localisation only\")")
+                  .withFlagOption("--localize-only", "localize"));
+  k.push_back(real("map.localize.min_probability", AT(map.localize.min_probability), 0.5, 0, 1, "",
+                   "localisation only: a frame whose best node's belief is under this answers \"not a known "
+                   "node\" (node -1)"));
+  k.push_back(real("map.localize.jump_weight", AT(map.localize.jump_weight), 0.01, 0, 1, "",
+                   "localisation only: weight of moving to any node, not only along the map's edges, between two "
+                   "frames (how fast a robot carried elsewhere is found again)"));
   k.push_back(text("map.path", AT(map.path), "map.tsm", 0, 4096,
                    "the map file (MapStore format, docs/topology.md). Relative paths resolve against "
                    "$STATE_DIRECTORY (systemd StateDirectory=toposlam: /var/lib/toposlam), else the working "
@@ -457,6 +468,11 @@ std::vector<ConfigKey> makeKeys() {
                       FiedlerSegmenterConfig::kMaxQuerySamples, "",
                       "other frames of a closed place that the relative likelihood compares with the stored places "
                       "besides its representative (0 = the representative alone, the thesis)"));
+  k.push_back(integer("segmentation.place_views", AT(segmentation.place_views), 7, 0,
+                      FiedlerSegmenterConfig::kMaxQuerySamples, "",
+                      "other frames of a closed place the map keeps as its views, spread over the place, for "
+                      "localisation only (map.mode: localize); they change no mapping decision. Each costs about "
+                      "5 kB per place in memory and in the map file (0 = the representative alone, the thesis)"));
   // Topology (TopologyFilterConfig, the stage's slicing beside it).
   k.push_back(integer("topology.particles", AT(topology.particles), 500, 1, 1000000, "",
                       "particles over topologies (thesis: 500)"));
@@ -567,13 +583,14 @@ std::vector<ConfigKey> makeKeys() {
 
 /// Marks the keys a map records (ConfigKey::recorded_in_map): every key of the stages that decide (the
 /// fingerprint, similarity, segmentation and topology sections) except those that only say how the work
-/// is spread or what is published, the keypoint backend (recorded under its older name "keypoints",
+/// is spread, what is published or what is kept for localisation (place_views), the keypoint backend (recorded under its older name "keypoints",
 /// fingerprintMapSettings, so that maps made before every setting was recorded compare with it), and the
 /// seed (a resumed map continues its own random state).
 void markMapSettings(std::vector<ConfigKey>& keys) {
   const std::vector<std::string> sections = {"fingerprint.", "similarity.", "segmentation.", "topology."};
   const std::vector<std::string> not_recorded = {"fingerprint.workers", "fingerprint.keypoints.backend",
-                                                 "topology.seed", "topology.slice_items", "topology.alternatives"};
+                                                 "topology.seed", "topology.slice_items", "topology.alternatives",
+                                                 "segmentation.place_views"};
   for (ConfigKey& key : keys) {
     bool in_section = false;
     for (const std::string& section : sections) in_section = in_section || key.path.rfind(section, 0) == 0;
@@ -699,7 +716,8 @@ const std::vector<ConfigSection>& daemonConfigSections() {
       {"lcm", "LCM transport and channel names"},
       {"lcm.channels", "channel names, 1 .. 255 characters each"},
       {"record", "the frames toposlamd processes, recorded for replay (docs/deploy.md)"},
-      {"map", "the map file: where, when it is saved, whether it is resumed"},
+      {"map", "the map file: where, when it is saved, whether it is resumed, or only localised in"},
+      {"map.localize", "localisation only (map.mode: localize): when a frame is not a known node"},
       {"watchdog", "systemd watchdog"},
       {"pipeline", "queues, threads and time budgets of the daemon's pipeline (docs/daemon.md)"},
       {"pipeline.queues", "queue capacities between the stage threads"},

@@ -30,6 +30,11 @@ MethodPreset methodPreset(const std::string& name) {
     // (DoorwayPassageConfig::min_outward_speed_fraction), office boundary F1 0.77 -> 0.90 and its
     // revisits stay 11 of 12; the real frames' figures are unchanged.
     p.segmentation.place_samples = 3;
+    // Seven views of each place besides its representative, kept in the map for the localisation-only
+    // mode (docs/daemon.md, "Localisation only"): with the representative alone a frame from another part
+    // of the place finds nothing like it. They change no mapping decision. Leave one set out preferred 15
+    // by at most 0.01 held out (docs/results.md, "Localisation only"); 7 costs half the memory.
+    p.segmentation.place_views = 7;
     p.topology.likelihood = LikelihoodModel::Relative;
     p.topology.relative_slope = 2.0;
     p.topology.relative_offset = 4.25;

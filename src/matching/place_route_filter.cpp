@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 namespace toposlam {
 
@@ -23,6 +24,28 @@ PlaceRouteFilter::PlaceRouteFilter(const PlaceRouteFilterConfig& config, int pla
   predicted_.assign(static_cast<std::size_t>(places), 0.0);
 }
 
+void PlaceRouteFilter::setSuccessors(std::vector<std::vector<Successor>> successors) {
+  if (successors.size() != belief_.size())
+    throw std::invalid_argument("route filter: successors of " + std::to_string(successors.size()) + " places for " +
+                                std::to_string(belief_.size()));
+  for (const auto& out : successors)
+    for (const Successor& s : out) {
+      if (s.place < 0 || static_cast<std::size_t>(s.place) >= belief_.size())
+        throw std::invalid_argument("route filter: successor " + std::to_string(s.place) + " is not a place");
+      if (!(s.weight > 0.0 && std::isfinite(s.weight)))
+        throw std::invalid_argument("route filter: a successor's weight must be positive and finite");
+    }
+  successors_ = std::move(successors);
+}
+
+void PlaceRouteFilter::setStayProbability(double stay) {
+  PlaceRouteFilterConfig next = config_;
+  next.stay_probability = stay;
+  if (std::string problem = next.validate(); !problem.empty())
+    throw std::invalid_argument("route filter config: " + problem);
+  config_ = next;
+}
+
 const std::vector<double>& PlaceRouteFilter::update(std::span<const double> image_probabilities) {
   const std::size_t k_places = belief_.size();
   if (image_probabilities.size() != k_places)
@@ -35,8 +58,17 @@ const std::vector<double>& PlaceRouteFilter::update(std::span<const double> imag
     for (std::size_t k = 0; k < k_places; ++k) predicted_[k] = jump * belief_sum;
     for (std::size_t j = 0; j < k_places; ++j) {
       predicted_[j] += config_.stay_probability * belief_[j];
-      const std::size_t next = j + 1 < k_places ? j + 1 : (config_.loop ? 0 : j);
-      predicted_[next] += (1.0 - config_.stay_probability) * belief_[j];
+      const double moving = (1.0 - config_.stay_probability) * belief_[j];
+      if (successors_.empty()) {
+        const std::size_t next = j + 1 < k_places ? j + 1 : (config_.loop ? 0 : j);
+        predicted_[next] += moving;
+        continue;
+      }
+      const std::vector<Successor>& out = successors_[j];
+      double total = 0.0;
+      for (const Successor& s : out) total += s.weight;
+      if (out.empty()) predicted_[j] += moving;
+      for (const Successor& s : out) predicted_[static_cast<std::size_t>(s.place)] += moving * s.weight / total;
     }
     for (double& p : predicted_) p /= row_sum;
   } else {

@@ -7,6 +7,7 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
@@ -188,6 +189,7 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
     place.keypoints = p.representative_keypoints;
     place.representative = p.representative;
     place.samples.assign(p.samples.begin(), p.samples.begin() + p.sample_count);
+    place.views = std::move(p.views);
     if (evidence_) {
       std::vector<double> evidence = evidence_->closePlace(p.first_frame, p.last_frame);
       if (evidence_to_filter_) place.evidence = std::move(evidence);
@@ -202,6 +204,7 @@ std::optional<ClosedPlace> FiedlerSegmentationStage::toClosedPlace(const Segment
   p.representative.reset();  // the topology stage holds it as long as it needs it
   p.samples = {};
   p.sample_count = 0;
+  p.views.clear();
   last_closed_ = std::move(p);
   return out;
 }
@@ -226,6 +229,8 @@ void ParticleFilterTopologyStage::loadMap(const std::string& path) { adoptMap(Ma
 
 void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   filter_ = std::move(loaded.filter);
+  views_ = std::move(loaded.views);
+  views_.resize(static_cast<std::size_t>(filter_->observationCount()));
   filter_->setCandidateSelection(candidates_);  // how this process compares, not saved with the map
   topology_.particles = filter_->config().particles;  // the map's, as every other setting of its filter
   // The application data lists the representative frames of the run that saved the map; frame numbers of
@@ -239,9 +244,86 @@ void ParticleFilterTopologyStage::adoptMap(LoadedMap loaded) {
   refresh();
 }
 
+MapNodes mapNodesOf(const TopologyParticleFilter& filter, const PlaceViews& views) {
+  MapNodes out;
+  if (filter.observationCount() == 0) throw std::invalid_argument("the map has no places to localise against");
+  const TopologyEstimate estimate = filter.estimate(1);
+  const std::vector<int>& assignment = estimate.best.assignment;
+  out.node_count = estimate.best.node_count;
+  std::vector<std::vector<Fingerprint>> references(static_cast<std::size_t>(out.node_count));
+  std::map<std::pair<int, int>, int> edges;
+  for (std::size_t k = 0; k < assignment.size(); ++k) {
+    const int node = assignment[k];
+    if (node < 0 || node >= out.node_count) continue;
+    if (const std::shared_ptr<const Fingerprint> f = filter.storedRepresentative(static_cast<int>(k)))
+      references[static_cast<std::size_t>(node)].push_back(*f);
+    if (k < views.size())
+      for (const auto& view : views[k])
+        if (view) references[static_cast<std::size_t>(node)].push_back(*view);
+    if (k > 0 && assignment[k - 1] >= 0 && assignment[k - 1] != node) ++edges[{assignment[k - 1], node}];
+  }
+  std::vector<int> index_of(static_cast<std::size_t>(out.node_count), -1);
+  for (int node = 0; node < out.node_count; ++node) {
+    auto& refs = references[static_cast<std::size_t>(node)];
+    if (refs.empty()) continue;
+    index_of[static_cast<std::size_t>(node)] = static_cast<int>(out.node_ids.size());
+    out.node_ids.push_back(node);
+    out.nodes.push_back({std::to_string(node), std::move(refs)});
+  }
+  if (out.node_ids.empty()) throw std::invalid_argument("the map keeps no representative to localise against");
+  out.successors.resize(out.node_ids.size());
+  for (const auto& [ends, count] : edges) {
+    const int from = index_of[static_cast<std::size_t>(ends.first)];
+    const int to = index_of[static_cast<std::size_t>(ends.second)];
+    if (from >= 0 && to >= 0) out.successors[static_cast<std::size_t>(from)].push_back({to, static_cast<double>(count)});
+  }
+  return out;
+}
+
+void ParticleFilterTopologyStage::startLocalizing(const NodeLocalizerConfig& config) {
+  localizer_ = std::make_unique<NodeLocalizer>(config, mapNodesOf(*filter_, views_));
+  localized_places_ = 0;
+  estimate_.place = -1;
+  estimate_.node = -1;
+  estimate_.probability = 0.0;
+  estimate_.is_new = false;
+  estimate_.alternatives.clear();
+}
+
+void ParticleFilterTopologyStage::observeFrame(const Fingerprint& fingerprint) {
+  if (!localizer_) return;
+  const NodeFix fix = localizer_->update(fingerprint, alternatives_);
+  estimate_.node = fix.node;
+  estimate_.probability = fix.probability;
+  estimate_.is_new = false;
+  estimate_.alternatives.clear();
+  for (const NodeFix::Alternative& a : fix.alternatives) estimate_.alternatives.push_back({a.node, a.probability});
+}
+
+FinishedPlace ParticleFilterTopologyStage::localizePlace(ClosedPlace place) {
+  localizer_->placeClosed(place.last_frame - place.first_frame + 1);
+  FinishedPlace done{std::move(place), PlaceAssignment{}};
+  const NodeFix fix = done.place.representative ? localizer_->localizeOnce(*done.place.representative) : NodeFix{};
+  // Numbered after the map's observations, as a resumed run's places are, so that no place number of this
+  // run names one of the map's; the map itself gains nothing.
+  done.assignment.place = filter_->observationCount() + localized_places_++;
+  done.place.place = done.assignment.place;
+  done.assignment.node = fix.node;
+  done.assignment.is_new = false;
+  done.assignment.probability = fix.probability;
+  estimate_.place = done.assignment.place;
+  return done;
+}
+
 void ParticleFilterTopologyStage::enqueuePlace(ClosedPlace place) { queue_.push_back(std::move(place)); }
 
 std::optional<FinishedPlace> ParticleFilterTopologyStage::advance(double budget_s) {
+  if (localizer_) {
+    if (queue_.empty()) return std::nullopt;
+    FinishedPlace done = localizePlace(std::move(queue_.front()));
+    queue_.pop_front();
+    return done;
+  }
   const double deadline = clock_.now() + budget_s;
   do {
     if (!filter_->stepInProgress()) {
@@ -257,6 +339,8 @@ std::optional<FinishedPlace> ParticleFilterTopologyStage::advance(double budget_
       FinishedPlace done{std::move(queue_.front()), PlaceAssignment{}};
       queue_.pop_front();
       representative_frames_.push_back(done.place.representative_frame);
+      views_.resize(static_cast<std::size_t>(filter_->observationCount() - 1));
+      views_.push_back(done.place.views);
       if (spans_.empty() || done.place.first_frame > spans_.back().last_frame)
         spans_.push_back({done.place.first_frame, done.place.last_frame, filter_->observationCount() - 1});
       if (done.place.last_frame > last_mapped_frame_) {
@@ -319,6 +403,10 @@ void ParticleFilterTopologyStage::refresh() {
 void ParticleFilterTopologyStage::locate(RevisitEstimate& r) const {
   r.match_place = -1;
   r.match_node = -1;
+  if (localizer_) {  // localisation only: the node the robot is in now is the frame's own answer
+    r.match_node = estimate_.node;
+    return;
+  }
   if (r.match_frame < 0) return;
   // The last span starting at or before the frame, if it reaches it.
   const auto it = std::upper_bound(spans_.begin(), spans_.end(), r.match_frame,
@@ -337,10 +425,13 @@ namespace {
 /// map writer thread, then MapStore's atomic replace (temporary file, fsync, rename).
 class FrozenMap final : public MapSnapshot {
  public:
-  FrozenMap(FrozenTopologyState state, std::string application_data, MapSettings settings)
-      : state_(std::move(state)), application_data_(std::move(application_data)), settings_(std::move(settings)) {}
+  FrozenMap(FrozenTopologyState state, std::string application_data, MapSettings settings, PlaceViews views)
+      : state_(std::move(state)),
+        application_data_(std::move(application_data)),
+        settings_(std::move(settings)),
+        views_(std::move(views)) {}
   void writeTo(const std::string& path) const override {
-    const std::string bytes = MapStore::encode(state_, application_data_, settings_);
+    const std::string bytes = MapStore::encode(state_, application_data_, settings_, views_);
     bytes_.store(bytes.size());
     MapStore::writeAtomically(path, bytes);
   }
@@ -350,6 +441,7 @@ class FrozenMap final : public MapSnapshot {
   FrozenTopologyState state_;
   std::string application_data_;
   MapSettings settings_;
+  PlaceViews views_;  ///< pointer copies: the views never change once stored
   mutable std::atomic<std::size_t> bytes_{0};
 };
 
@@ -366,7 +458,7 @@ std::unique_ptr<const MapSnapshot> ParticleFilterTopologyStage::snapshotMap() co
     settings[kMapSourceLastFrameKey] = std::to_string(last_mapped_frame_);
     settings[kMapSourceLastFrameNameKey] = last_mapped_name_;
   }
-  return std::make_unique<FrozenMap>(filter_->freeze(), data.str(), std::move(settings));
+  return std::make_unique<FrozenMap>(filter_->freeze(), data.str(), std::move(settings), views_);
 }
 
 }  // namespace toposlam

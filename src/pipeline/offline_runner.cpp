@@ -35,6 +35,8 @@ SegmenterStep OfflineRunner::segment(double source_time_s, const std::string& na
   row.name = name;
   row.keypoints = fingerprint ? fingerprint->keypointCount() : 0;
   // The offline run has no pipeline clock: motion is looked up at the frame's own time, the motion file's.
+  const bool localizing = topology_ != nullptr && topology_->localizing();
+  std::shared_ptr<const Fingerprint> kept = localizing ? fingerprint : nullptr;
   SegmentationStep stage_step = segmentation_.process(row.frame, source_time_s, source_time_s, std::move(fingerprint), cv::Mat());
   row.time_s = segmentation_.lastFrameTimeS();
   SegmenterStep step;
@@ -44,6 +46,9 @@ SegmenterStep OfflineRunner::segment(double source_time_s, const std::string& na
   run_.frames.push_back(std::move(row));
   revisits_.push_back(stage_step.revisit);
   pending_ = std::move(stage_step.closed);
+  // toposlamd's topology thread steps a closed place before it answers for the frame that closed it.
+  if (kept && pending_) unobserved_ = std::move(kept);
+  else if (kept) observe(*kept);
   if (segmentation_.lastClosedPlace()) {
     step.closed_place = *segmentation_.lastClosedPlace();
     record(*step.closed_place);
@@ -57,7 +62,14 @@ std::optional<MappedPlace> OfflineRunner::mapPlace(const SegmentedPlace& place) 
     throw std::logic_error("OfflineRunner::mapPlace: not the kept place the segmentation closed last");
   topology_->enqueuePlace(std::move(*pending_));
   pending_.reset();
-  while (!topology_->idle()) topology_->advance(std::numeric_limits<double>::infinity());
+  while (!topology_->idle())
+    if (std::optional<FinishedPlace> done = topology_->advance(std::numeric_limits<double>::infinity());
+        done && topology_->localizing())
+      localized_place_nodes_.push_back(done->assignment.node);
+  if (unobserved_) {
+    observe(*unobserved_);
+    unobserved_.reset();
+  }
   MappedPlace mapped{place, topology_->filter().estimate(3)};
   mapped.place.representative.reset();
   steps_.push_back(mapped);
@@ -82,6 +94,11 @@ void OfflineRunner::finish() {
   if (std::optional<SegmentedPlace> last = finishTraversal()) mapPlace(*last);
 }
 
+void OfflineRunner::observe(const Fingerprint& fingerprint) {
+  topology_->observeFrame(fingerprint);
+  frame_nodes_.push_back({topology_->estimate().node, topology_->estimate().probability});
+}
+
 void OfflineRunner::record(const SegmentedPlace& place) {
   const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, place.first_frame));
   const auto end = std::min(run_.frames.size(), static_cast<std::size_t>(place.last_frame + 1));
@@ -95,6 +112,7 @@ void OfflineRunner::record(const SegmentedPlace& place) {
 std::vector<std::int64_t> OfflineRunner::placeNodes() const {
   std::vector<std::int64_t> nodes;
   if (topology_ == nullptr) return nodes;
+  if (topology_->localizing()) return localized_place_nodes_;
   // The topology stage's snapshot (the one toposlamd publishes) lists each node's places by observation.
   const TopologySnapshot best = topology_->topology();
   nodes.assign(static_cast<std::size_t>(topology_->observations() - first_observation_), -1);

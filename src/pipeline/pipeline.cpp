@@ -339,6 +339,7 @@ void Pipeline::fingerprintLoop() {
 }
 
 void Pipeline::segmentationLoop() {
+  const bool observes_frames = topology_.observesFrames();  // fixed before the threads start
   try {
     bool input_ended = false;
     for (;;) {
@@ -353,6 +354,7 @@ void Pipeline::segmentationLoop() {
       }
       if (wait == QueueWait::Timeout) continue;
       const double t0 = clock_.now();
+      if (observes_frames) in.result.fingerprint = in.fingerprint;  // localisation only: the topology stage's
       SegmentationStep step = segmentation_.process(in.result.sequence, in.result.source_time_s, in.result.captured_at_s,
                                                        std::move(in.fingerprint),
                                                        in.thumbnail);
@@ -383,7 +385,7 @@ void Pipeline::segmentationLoop() {
 }
 
 void Pipeline::saveMap(bool final) {
-  if (map_.path.empty()) return;
+  if (map_.path.empty() || !topology_.savesMap()) return;  // localisation only: the map stays as loaded
   const double t0 = clock_.now();
   MapWrite job{topology_.snapshotMap(), final, 0.0};
   job.snapshot_ms = (clock_.now() - t0) * 1e3;
@@ -519,6 +521,10 @@ void Pipeline::topologyLoop() {
           if (remaining <= 0.0) break;
           if (std::optional<FinishedPlace> done = topology_.advance(remaining))
             r.finished_places.push_back(std::move(*done));
+        }
+        if (r.fingerprint) {  // localisation only: the estimate answers for this frame
+          topology_.observeFrame(*r.fingerprint);
+          r.fingerprint.reset();
         }
         stampEstimate(r);
         r.filter_ms = (clock_.now() - t0) * 1e3;

@@ -8,6 +8,14 @@ namespace {
 constexpr std::size_t kKeptThumbnails = 600;
 }  // namespace
 
+NodeLocalizerConfig nodeLocalizerConfig(const NgramSimilarityConfig& similarity, const MapLocalizeConfig& localize) {
+  NodeLocalizerConfig c;
+  c.localizer.similarity = similarity;
+  c.min_probability = localize.min_probability;
+  c.jump_weight = localize.jump_weight;
+  return c;
+}
+
 StageAssembly::StageAssembly(const StageSettings& settings, const Clock& clock, WorkerPool* pool,
                              Thumbnails thumbnails) {
   const bool kept = thumbnails == Thumbnails::Kept;

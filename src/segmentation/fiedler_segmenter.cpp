@@ -108,6 +108,9 @@ std::string FiedlerSegmenterConfig::validate() const {
   if (place_samples < 0 || place_samples > kMaxQuerySamples)
     return "place_samples: " + std::to_string(place_samples) + " is outside the allowed range [0, " +
            std::to_string(kMaxQuerySamples) + "]";
+  if (place_views < 0 || place_views > kMaxQuerySamples)
+    return "place_views: " + std::to_string(place_views) + " is outside the allowed range [0, " +
+           std::to_string(kMaxQuerySamples) + "]";
   if (auto p = outside("min_frame_spacing_rad", min_frame_spacing_rad, 0, 10, " rad", "")) return *p;
   if (auto p = outside("doorway_shift_s", doorway_shift_s, 0, 60, " s", " (0 = off)")) return *p;
   if (min_window_frames < 3 || min_window_frames > window) {
@@ -180,7 +183,7 @@ FiedlerSegmenter::FiedlerSegmenter(const FiedlerSegmenterConfig& config, const S
                                                    FiedlerSegmenterConfig::kMaxPlaceSamples);
     sample_interval_s_ = config_.representative_interval_s;
   }
-  if (config_.place_samples > 0) {
+  if (config_.place_samples > 0 || config_.place_views > 0) {
     query_samples_.reserve(FiedlerSegmenterConfig::kMaxPlaceSamples);
     query_sample_interval_s_ = config_.representative_interval_s;
   }
@@ -209,17 +212,20 @@ void FiedlerSegmenter::takeQuerySamples(SegmentedPlace& place, std::int64_t last
   while (first < in_place && query_samples_[first].frame < place.first_frame) ++first;
   std::size_t others = 0;
   for (std::size_t i = first; i < in_place; ++i) others += query_samples_[i].frame != place.representative_frame;
-  const std::size_t take = std::min(others, static_cast<std::size_t>(config_.place_samples));
   // The k-th of `take` is the ((2k + 1) * others / (2 take))-th other sample: the middles of equal parts.
-  std::size_t seen = 0, k = 0;
-  for (std::size_t i = first; i < in_place && k < take; ++i) {
-    if (query_samples_[i].frame == place.representative_frame) continue;
-    if (seen == (2 * k + 1) * others / (2 * take)) {
-      place.samples[k++] = query_samples_[i].fingerprint;
+  const auto spread = [&](int wanted, const auto& keep) {
+    const std::size_t take = std::min(others, static_cast<std::size_t>(wanted));
+    std::size_t seen = 0, k = 0;
+    for (std::size_t i = first; i < in_place && k < take; ++i) {
+      if (query_samples_[i].frame == place.representative_frame) continue;
+      if (seen == (2 * k + 1) * others / (2 * take)) keep(k++, query_samples_[i].fingerprint);
+      ++seen;
     }
-    ++seen;
-  }
-  place.sample_count = static_cast<int>(k);
+    return static_cast<int>(k);
+  };
+  place.sample_count = spread(config_.place_samples, [&](std::size_t k, const auto& f) { place.samples[k] = f; });
+  place.views.clear();
+  spread(config_.place_views, [&](std::size_t, const auto& f) { place.views.push_back(f); });
   query_samples_.erase(query_samples_.begin(), query_samples_.begin() + static_cast<std::ptrdiff_t>(in_place));
   query_sample_interval_s_ = config_.representative_interval_s;
 }
@@ -537,7 +543,7 @@ SegmenterStep FiedlerSegmenter::addFrameAt(std::int64_t frame_index, double time
   }
   rememberBestWindowFrame(place_start_, std::numeric_limits<std::int64_t>::max());
   if (config_.representative == RepresentativeChoice::PlaceMedoid) samplePlaceFrame(slot);
-  if (config_.place_samples > 0) sampleQueryFrame(slot);
+  if (config_.place_samples > 0 || config_.place_views > 0) sampleQueryFrame(slot);
 
   // The detector sees lambda2 only once the window is full: while it fills, lambda2 of a perfectly
   // connected window falls as k/(k-1) (2, 1.5, 1.33, ...), which would read as a peak.
@@ -752,7 +758,7 @@ SegmentedPlace FiedlerSegmenter::closePlace(std::int64_t valley_frame, std::int6
     place.representative = best->fingerprint;
     place.representative_keypoints = best->keypoints;
   }
-  if (config_.place_samples > 0) takeQuerySamples(place, last_frame);
+  if (config_.place_samples > 0 || config_.place_views > 0) takeQuerySamples(place, last_frame);
   place.dropped = place.representative_keypoints < config_.min_keypoints;
   place.index = place.dropped ? dropped_places_++ : kept_places_++;
 

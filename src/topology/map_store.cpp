@@ -94,13 +94,55 @@ MapSettings fingerprintMapSettings(const VpackConfig& config) {
   return MapSettings{{"keypoints", toString(config.keypoints.backend)}};
 }
 
+namespace {
+
+/// The views section: one entry per observation (missing ones empty, extra ones left out).
+void appendViews(std::string& out, const PlaceViews& views, int observations) {
+  topology_detail::BinaryWriter w(std::move(out));
+  w.u64(static_cast<std::uint64_t>(observations));
+  for (int o = 0; o < observations; ++o) {
+    const auto k = static_cast<std::size_t>(o);
+    std::uint32_t n = 0;
+    if (k < views.size())
+      for (const auto& v : views[k]) n += v ? 1u : 0u;
+    w.u32(n);
+    if (k >= views.size()) continue;
+    for (const auto& v : views[k])
+      if (v) w.bytesFrom([&](std::string& bytes) { appendFingerprintBytes(bytes, *v); });
+  }
+  out = w.take();
+}
+
+PlaceViews readViews(std::string_view section, int observations) {
+  topology_detail::BinaryReader r(section);
+  const std::uint64_t count = r.u64("view count");
+  if (count != static_cast<std::uint64_t>(observations))
+    throw std::runtime_error("the views are of " + std::to_string(count) + " places, the filter has " +
+                             std::to_string(observations));
+  PlaceViews views(static_cast<std::size_t>(observations));
+  for (auto& place : views) {
+    const std::uint32_t n = r.u32("views of a place");
+    if (n > 1024) throw std::runtime_error("a place has " + std::to_string(n) + " views");
+    for (std::uint32_t i = 0; i < n; ++i) {
+      auto view = std::make_shared<Fingerprint>(fingerprintFromBytes(r.bytes("view")));
+      if (const std::string problem = view->validate(); !problem.empty())
+        throw std::runtime_error("an invalid view: " + problem);
+      place.push_back(std::move(view));
+    }
+  }
+  if (!r.atEnd()) throw std::runtime_error("trailing bytes in the views");
+  return views;
+}
+
+}  // namespace
+
 std::string MapStore::encode(const TopologyParticleFilter& filter, std::string_view application_data,
-                             const MapSettings& settings) {
-  return encode(filter.freeze(), application_data, settings);
+                             const MapSettings& settings, const PlaceViews& views) {
+  return encode(filter.freeze(), application_data, settings, views);
 }
 
 std::string MapStore::encode(const FrozenTopologyState& frozen, std::string_view application_data,
-                             const MapSettings& settings) {
+                             const MapSettings& settings, const PlaceViews& views) {
   // One buffer: the header with room for the size and checksum, the payload after it (the state written
   // in place), then the two fields filled in. No copy of the payload, which is ~5 KB per stored place.
   topology_detail::BinaryWriter file;
@@ -112,6 +154,7 @@ std::string MapStore::encode(const FrozenTopologyState& frozen, std::string_view
   file.bytesFrom([&](std::string& out) { frozen.appendState(out); });
   file.bytes(application_data);
   file.bytes(settingsText(settings));
+  file.bytesFrom([&](std::string& out) { appendViews(out, views, frozen.observationCount()); });
   std::string out = file.take();
   const std::string_view payload = std::string_view(out).substr(kHeaderSize);
   const std::uint64_t checksum = mapPayloadChecksum(kMapFormatVersion, payload);
@@ -163,8 +206,11 @@ LoadedMap MapStore::decode(std::string_view file, const SimilarityMeasure& simil
     LoadedMap loaded;
     loaded.application_data = std::string(reader.bytes("application data"));
     if (version >= 2) loaded.settings = parseSettings(reader.bytes("settings"), name);
+    const std::string_view views = version >= 5 ? reader.bytes("views") : std::string_view();
     if (!reader.atEnd()) throw std::runtime_error("trailing bytes in the payload");
     loaded.filter = TopologyParticleFilter::loadState(state, similarity);
+    const int observations = loaded.filter->observationCount();
+    loaded.views = version >= 5 ? readViews(views, observations) : PlaceViews(static_cast<std::size_t>(observations));
     return loaded;
   } catch (const MapStoreError&) {
     throw;

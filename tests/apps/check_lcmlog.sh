@@ -49,6 +49,11 @@ out="$("$toposlam" report "lcmlog:$log" 2>&1)" || fail "report lcmlog: $out"
 echo "$out" | grep -q "^converted $log ([0-9]* events: 481 place estimates, $places places) into the run folder $log.run$" \
   || fail "report lcmlog: $out"
 grep -q "<svg" "$log.run/report.html" || fail "the report has no figure"
+# The log alone carries one picture per place: every frame of the strip shows its place's, and nothing is
+# "could not be read" (it was, for every frame but the representatives).
+"$toposlam" report "lcmlog:$log" --json >"$dir/report-log.json" 2>/dev/null || fail "report lcmlog --json"
+python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['thumbnails'] >= 50 and r['warnings'] == 0, r" \
+  "$dir/report-log.json" || fail "report of the log alone: $(cat "$dir/report-log.json")"
 # With the daemon's own recording as the frames: every thumbnail found (frames.csv names them as recorded).
 "$toposlam" report "lcmlog:$log" --frames "$(ls -d "$dir"/rec/*Z)" --json >"$dir/report.json" 2>/dev/null || fail "report --frames"
 python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['frames'] == 481 and r['thumbnails'] >= 50 and r['warnings'] == 0, r" \

@@ -130,7 +130,7 @@ SCENARIO("GIVEN the stage structs as constructed WHEN compared with the key tabl
   CHECK(differ == std::set<std::string>{
                       "fingerprint.keypoints.orb_levels", "segmentation.doorway_borders", "segmentation.doorway_shift_s",
                       "segmentation.min_frame_spacing_m", "segmentation.min_frame_spacing_rad",
-                      "segmentation.place_samples", "segmentation.window_s", "similarity.histogram_only_fallback",
+                      "segmentation.place_samples", "segmentation.place_views", "segmentation.window_s", "similarity.histogram_only_fallback",
                       "similarity.histogram_weight", "similarity.keypoint_scoring",
                       "similarity.matcher.max_angle_difference_deg", "similarity.matcher.mutual_check",
                       "similarity.matcher.ratio_test", "topology.gamma_scale", "topology.gamma_shape",
@@ -270,7 +270,7 @@ SCENARIO("GIVEN a command-line value WHEN set by its key's path THEN it is read 
   std::set<std::string> options;
   for (const ConfigKey& key : daemonConfigKeys())
     if (!key.option.empty()) options.insert(key.option);
-  CHECK(options == std::set<std::string>{"--source", "--log-level", "--lcm-url", "--map", "--no-map-load",
+  CHECK(options == std::set<std::string>{"--source", "--log-level", "--lcm-url", "--map", "--localize-only", "--no-map-load",
                                          "--resume-other-source", "--resume-other-settings", "--source-from-start",
                                          "--save-period", "--overflow", "--record"});
 }

@@ -94,3 +94,34 @@ SCENARIO("GIVEN bad input WHEN the filter is built or fed THEN it says what is w
   CHECK_THROWS_WITH(filter.update(std::vector<double>{0.5, 0.5}),
                     Catch::Contains("2 image probabilities for 3 places"));
 }
+
+SCENARIO("GIVEN a map's graph of successors WHEN an image arrives THEN the moving share is split over the edges by weight",
+         "[route]") {
+  // Node 0 leads to 1 (weight 3) and 2 (weight 1); node 1 has no successor (it keeps its share); 2 leads to 0.
+  PlaceRouteFilter filter(config(0.5, 0.0, true), 3);
+  filter.setSuccessors({{{1, 3.0}, {2, 1.0}}, {}, {{0, 1.0}}});
+  filter.update(std::vector<double>{1.0, 0.0, 0.0});  // certain: node 0
+  // Prediction from node 0: stay 0.5, to 1 0.5 * 3/4 = 0.375, to 2 0.125; the image is uniform.
+  const std::vector<double>& b = filter.update(std::vector<double>{1.0, 1.0, 1.0});
+  CHECK(b[0] == Approx(0.5));
+  CHECK(b[1] == Approx(0.375));
+  CHECK(b[2] == Approx(0.125));
+  // From node 1 (no successor) the whole belief stays there.
+  PlaceRouteFilter dead_end(config(0.5, 0.0, true), 3);
+  dead_end.setSuccessors({{{1, 1.0}}, {}, {}});
+  dead_end.update(std::vector<double>{0.0, 1.0, 0.0});
+  CHECK(dead_end.update(std::vector<double>{1.0, 1.0, 1.0})[1] == Approx(1.0));
+  // The share of staying can be changed between updates, within [0, 1].
+  filter.setStayProbability(1.0);
+  CHECK(filter.update(std::vector<double>{1.0, 1.0, 1.0})[0] == Approx(0.5));
+  CHECK_THROWS_WITH(filter.setStayProbability(1.5), Catch::Contains("stay_probability"));
+}
+
+SCENARIO("GIVEN successors that do not fit WHEN they are set THEN they are refused by what is wrong", "[route]") {
+  PlaceRouteFilter filter(PlaceRouteFilterConfig{}, 2);
+  CHECK_THROWS_WITH(filter.setSuccessors({{}}), Catch::Contains("successors of 1 places for 2"));
+  CHECK_THROWS_WITH(filter.setSuccessors({{{2, 1.0}}, {}}), Catch::Contains("successor 2 is not a place"));
+  CHECK_THROWS_WITH(filter.setSuccessors({{{1, 0.0}}, {}}), Catch::Contains("positive and finite"));
+  CHECK_THROWS_WITH(filter.setSuccessors({{{1, std::numeric_limits<double>::infinity()}}, {}}),
+                    Catch::Contains("positive and finite"));
+}

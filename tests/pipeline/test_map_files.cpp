@@ -389,6 +389,27 @@ TEST_CASE("GIVEN a map file over the size cap WHEN loaded or recovered THEN it i
   fs::remove(huge);
 }
 
+namespace {
+
+/// A map image of format 5 re-framed as format 4 wrote it: the same payload without the views section.
+std::string asVersion4(const std::string& image) {
+  REQUIRE(image[8] == 5);
+  std::size_t at = 32;
+  for (int field = 0; field < 3; ++field) {  // bytes(filter state), bytes(application data), bytes(settings)
+    std::uint64_t size = 0;
+    for (int i = 0; i < 8; ++i) size |= std::uint64_t{static_cast<unsigned char>(image[at + i])} << (8 * i);
+    at += 8 + size;
+  }
+  const std::string payload = image.substr(32, at - 32);
+  std::string out = image.substr(0, 8) + std::string("\x04\0\0\0\0\0\0\0", 8);
+  for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((payload.size() >> (8 * i)) & 0xff));
+  const std::uint64_t sum = mapPayloadChecksum(4, payload);
+  for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((sum >> (8 * i)) & 0xff));
+  return out + payload;
+}
+
+}  // namespace
+
 TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run THEN refused naming both",
           "[topology][map][reliability]") {
   auto sim = placeSimilarity();
@@ -407,8 +428,9 @@ TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run T
              Catch::Contains(path.string()) && Catch::Contains("keypoints=orb") && Catch::Contains("keypoints=sift"));
 
   SECTION("a version-2 map (FNV-1a checksum) still loads; versions 3 and 4 carry zlib's CRC-32") {
-    std::string v3 = MapStore::encode(*filter, "data", fingerprintMapSettings(orb));
+    std::string v3 = asVersion4(MapStore::encode(*filter, "data", fingerprintMapSettings(orb)));
     REQUIRE(v3[8] == 4);
+    CHECK(MapStore::decode(v3, sim).settings == MapSettings{{"keypoints", "orb"}});
     v3[8] = 3;  // the same layout: version 4 only records more settings
     CHECK(MapStore::decode(v3, sim).settings == MapSettings{{"keypoints", "orb"}});
     const std::string payload = v3.substr(32);
@@ -431,7 +453,7 @@ TEST_CASE("GIVEN a map made with ORB keypoints WHEN checked against a SIFT run T
   }
   SECTION("a version-1 map (no settings) still loads and is accepted") {
     // Re-frame the payload without the settings block, as version 1 wrote it.
-    const std::string v3 = MapStore::encode(*filter, "data");
+    const std::string v3 = asVersion4(MapStore::encode(*filter, "data"));
     std::string payload = v3.substr(32);
     REQUIRE(payload.substr(payload.size() - 8) == std::string(8, '\0'));  // bytes("") of the empty settings
     payload.resize(payload.size() - 8);

@@ -210,3 +210,62 @@ TEST_CASE(
   CHECK_FALSE(verifies(newer, 1000));
   CHECK_FALSE(MapFramingCheck().start("TSLMAP", 6));  // shorter than a header
 }
+
+namespace {
+
+/// The map image `image` as format 4 wrote it: the same filter, application data and settings, no views.
+std::string withoutViews(const std::string& image) {
+  constexpr std::size_t kHeader = 32;
+  std::size_t at = kHeader;
+  for (int field = 0; field < 3; ++field) {  // bytes(filter state), bytes(application data), bytes(settings)
+    std::uint64_t size = 0;
+    for (int i = 0; i < 8; ++i) size |= std::uint64_t{static_cast<unsigned char>(image[at + i])} << (8 * i);
+    at += 8 + size;
+  }
+  std::string payload = image.substr(kHeader, at - kHeader);
+  std::string out = image.substr(0, 8);
+  const auto put = [&out](std::uint64_t value, int bytes) {
+    for (int i = 0; i < bytes; ++i) out.push_back(static_cast<char>((value >> (8 * i)) & 0xff));
+  };
+  put(4, 4);
+  put(0, 4);
+  put(payload.size(), 8);
+  put(mapPayloadChecksum(4, payload), 8);
+  return out + payload;
+}
+
+}  // namespace
+
+TEST_CASE("GIVEN a map with its places' views WHEN saved and loaded THEN every place keeps its views, and a map "
+          "of format 4 loads with none",
+          "[topology][map]") {
+  auto sim = placeSimilarity();
+  auto filter = smallFilter(sim, 5);
+  REQUIRE(filter->observationCount() == 5);
+  PlaceViews views(3);  // shorter than the observations: the rest have none
+  views[0] = {taggedFingerprint(1), taggedFingerprint(2)};
+  views[2] = {taggedFingerprint(3)};
+  const std::string image = MapStore::encode(*filter, "data", {{"keypoints", "orb"}}, views);
+  const LoadedMap loaded = MapStore::decode(image, sim);
+  REQUIRE(loaded.views.size() == 5);
+  CHECK(loaded.views[0].size() == 2);
+  CHECK(loaded.views[0][1]->image_width == 3);
+  CHECK(loaded.views[1].empty());
+  CHECK(loaded.views[2].size() == 1);
+  CHECK(loaded.views[3].empty());
+  CHECK(loaded.views[4].empty());
+  CHECK(loaded.application_data == "data");
+  // Without views the image is the one a map without them always gave.
+  CHECK(MapStore::encode(*filter, "data", {{"keypoints", "orb"}}) ==
+        MapStore::encode(*filter, "data", {{"keypoints", "orb"}}, PlaceViews(5)));
+  CHECK(image.size() > MapStore::encode(*filter, "data", {{"keypoints", "orb"}}).size());
+  // Format 4 had no views: it loads, each place with none.
+  const LoadedMap old = MapStore::decode(withoutViews(image), sim);
+  CHECK(old.filter->observationCount() == 5);
+  CHECK(old.views.size() == 5);
+  CHECK(std::all_of(old.views.begin(), old.views.end(), [](const auto& v) { return v.empty(); }));
+  CHECK(old.settings.at("keypoints") == "orb");
+  // A version 5 image whose views section was cut is damaged, named so.
+  CHECK_THROWS_WITH(MapStore::decode(withoutViews(image).replace(8, 1, 1, '\x05'), sim),
+                    Catch::Contains("damaged") || Catch::Contains("checksum"));
+}

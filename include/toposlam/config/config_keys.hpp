@@ -46,6 +46,8 @@ struct ConfigKey {
   /// The toposlamd option overriding the key ("" = none). A Flag's option sets `option_sets`.
   std::string option;
   bool option_sets = true;
+  /// A Choice key whose option is a flag: the value the flag sets ("" = an option taking the value).
+  std::string option_value;
   /// A constraint involving other keys: "" or the problem without the key's path (e.g. "0.3 is out of
   /// range, allowed [0, gamma = 0.2]"). Checked after every key's own range.
   std::function<std::string(const DaemonConfig&)> cross_check;
@@ -69,6 +71,12 @@ struct ConfigKey {
   // Table-building helpers (chainable).
   ConfigKey& withNote(std::string text) { note = std::move(text); return *this; }
   ConfigKey& withOption(std::string name, bool sets = true) { option = std::move(name); option_sets = sets; return *this; }
+  /// A flag option that sets this choice key to `value` (`--localize-only` sets map.mode to localize).
+  ConfigKey& withFlagOption(std::string name, std::string value) {
+    option = std::move(name);
+    option_value = std::move(value);
+    return *this;
+  }
   ConfigKey& withCrossCheck(std::function<std::string(const DaemonConfig&)> check) { cross_check = std::move(check); return *this; }
   ConfigKey& exclusive(bool low_end, bool high_end) { low_open = low_end; high_open = high_end; return *this; }
 };

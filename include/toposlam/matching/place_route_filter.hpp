@@ -14,7 +14,13 @@
 // traversal has no prediction: its belief is the image's own probabilities.
 //
 // Measured on both bundled real sets (docs/matching.md, "Localisation along a route"); chosen there:
-// stay 0.7, jump 0.01. Plain class: no I/O, no clock, no randomness.
+// stay 0.7, jump 0.01.
+//
+// On a map the route is a graph: setSuccessors() replaces "the next place" with each place's successors
+// in the map (the topology's edges), the (1 - stay) share split over them by weight. A place without a
+// successor keeps that share (the robot stays until the evidence says otherwise). The localisation-only
+// mode runs it over the map's nodes, frame by frame (docs/daemon.md, "Localisation only").
+// Plain class: no I/O, no clock, no randomness.
 #pragma once
 
 #include <span>
@@ -40,6 +46,19 @@ class PlaceRouteFilter {
   /// or non-finite) leaves the prediction alone. Throws std::invalid_argument on a size mismatch.
   const std::vector<double>& update(std::span<const double> image_probabilities);
 
+  /// One place's successors: (place, weight > 0), e.g. the map's edges with their traversal counts.
+  struct Successor {
+    int place = 0;
+    double weight = 1.0;
+  };
+  /// Replaces the route by a graph: successors[j] are the places reached from place j (one list per
+  /// place). Throws std::invalid_argument on a size mismatch, a place out of range or a weight that is
+  /// not positive and finite.
+  void setSuccessors(std::vector<std::vector<Successor>> successors);
+  /// Changes the share of staying between two updates (e.g. calibrated from the stream's place lengths);
+  /// throws std::invalid_argument outside [0, 1].
+  void setStayProbability(double stay);
+
   /// Starts a new traversal: the next update has no prediction.
   void reset() { started_ = false; }
 
@@ -50,6 +69,7 @@ class PlaceRouteFilter {
   PlaceRouteFilterConfig config_;
   std::vector<double> belief_;
   std::vector<double> predicted_;  // scratch, reused
+  std::vector<std::vector<Successor>> successors_;  // empty: the route (k -> k + 1)
   bool started_ = false;
 };
 

@@ -21,6 +21,7 @@
 #include "toposlam/pipeline/stages.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/topology/map_store.hpp"
+#include "toposlam/matching/node_localizer.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
 
@@ -186,6 +187,13 @@ class FiedlerSegmentationStage final : public SegmentationStage {
 /// (read from `clock`) is spent. Place index = filter observation index, so numbering continues across
 /// restarts from a saved map. The map file (MapStore) carries, as application data, the representative
 /// frame of each observation.
+/// The nodes of a map's most probable topology as the localisation-only mode needs them: those with at least
+/// one stored representative (the others cannot be recognised and are left out), and the edges between them.
+/// Throws std::invalid_argument for a map without places or representatives.
+/// A node's references are its places' representatives and their views (`views`, per observation; may be
+/// shorter than the observations).
+MapNodes mapNodesOf(const TopologyParticleFilter& filter, const PlaceViews& views = {});
+
 class ParticleFilterTopologyStage final : public TopologyStage {
  public:
   ParticleFilterTopologyStage(const TopologyFilterConfig& config, const SimilarityMeasure& similarity,
@@ -208,6 +216,17 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   }
   std::int64_t lastMappedFrame() const { return last_mapped_frame_; }
 
+  /// Localisation only (map.mode: localize; docs/daemon.md): from now on the map never changes. Every frame
+  /// given to observeFrame() is localised among the loaded map's nodes (NodeLocalizer) and the estimate
+  /// answers for that frame (node -1: not a known node); a closed place gets the node of its
+  /// representative and is never a new node. Call after loadMap()/adoptMap(). Throws
+  /// std::invalid_argument for an invalid config or a map without places.
+  void startLocalizing(const NodeLocalizerConfig& config);
+  bool localizing() const { return localizer_ != nullptr; }
+  bool observesFrames() const override { return localizing(); }
+  void observeFrame(const Fingerprint& fingerprint) override;
+  bool savesMap() const override { return !localizing(); }
+
   void enqueuePlace(ClosedPlace place) override;
   std::optional<FinishedPlace> advance(double budget_s) override;
   std::size_t queuedPlaces() const override { return queue_.size(); }
@@ -221,9 +240,12 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   /// The filter itself, read-only (its full estimate, its config, MapStore::save); valid until the next
   /// loadMap() or adoptMap().
   const TopologyParticleFilter& filter() const { return *filter_; }
+  /// Every observation's views (ClosedPlace::views), as the map stores them.
+  const PlaceViews& views() const { return views_; }
 
  private:
   void refresh();  ///< recomputes estimate_ and topology_ after a finished step (or a load)
+  FinishedPlace localizePlace(ClosedPlace place);  ///< localisation only: the place's node, no step
 
   const SimilarityMeasure& similarity_;
   const Clock& clock_;
@@ -250,6 +272,9 @@ class ParticleFilterTopologyStage final : public TopologyStage {
   PlaceEstimate estimate_;
   TopologySnapshot topology_;
   MapSettings map_settings_;
+  PlaceViews views_;                          ///< per observation: the place's views
+  std::unique_ptr<NodeLocalizer> localizer_;  ///< localisation only
+  int localized_places_ = 0;                  ///< localisation only: places of this run so far
 };
 
 }  // namespace toposlam

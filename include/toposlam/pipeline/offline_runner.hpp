@@ -78,9 +78,18 @@ class OfflineRunner {
   /// Filter observations that came before this run (a resumed map).
   int earlierObservations() const { return first_observation_; }
   int traversals() const { return traversal_count_; }
+  /// Localisation only (the topology stage localises, ParticleFilterTopologyStage::startLocalizing): every
+  /// frame's answer as toposlamd publishes it in place_t (node -1: not a known node), in run numbering.
+  struct FrameNode {
+    int node = -1;
+    double probability = 0.0;
+  };
+  const std::vector<FrameNode>& frameNodes() const { return frame_nodes_; }
 
  private:
   void record(const SegmentedPlace& place);
+  /// Localisation only: the frame's answer, after its place's step as on toposlamd's topology thread.
+  void observe(const Fingerprint& fingerprint);
 
   FingerprintStage& fingerprint_;
   FiedlerSegmentationStage& segmentation_;
@@ -92,6 +101,9 @@ class OfflineRunner {
   SegmentationRun run_;
   std::vector<RevisitEstimate> revisits_;
   std::vector<MappedPlace> steps_;
+  std::vector<FrameNode> frame_nodes_;
+  std::vector<std::int64_t> localized_place_nodes_;  ///< localisation only: per kept place of this run
+  std::shared_ptr<const Fingerprint> unobserved_;     ///< localisation only: waits for its place's step
 };
 
 }  // namespace toposlam

@@ -93,7 +93,18 @@ struct PipelineConfig {
 
 /// map.*: the map file. The Pipeline saves it (path, save_period_s); toposlamd decides at start what it
 /// loads (load_at_start, resume_other_source, resume_other_settings, source_from_start, max_mb).
+/// map.mode: build the map (and resume it), or localise in a saved map that never changes.
+enum class MapMode { Map, Localize };
+
+/// map.localize.*: the localisation-only mode's settings (NodeLocalizer; docs/daemon.md).
+struct MapLocalizeConfig {
+  double min_probability = 0.5;  ///< a frame's best node under this belief answers "not a known node"
+  double jump_weight = 0.01;     ///< weight of moving to any node off the map's edges (relocalisation)
+};
+
 struct MapConfig {
+  MapMode mode = MapMode::Map;  ///< map.mode
+  MapLocalizeConfig localize;   ///< map.localize.*
   std::string path;  ///< map.path: where the map is saved; empty = never saved
   /// map.save_period_s: periodic save, seconds (0 = only at stop; else 1 .. 86400)
   double save_period_s = 60.0;

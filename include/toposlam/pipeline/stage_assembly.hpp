@@ -13,6 +13,7 @@
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
 #include "toposlam/pipeline/clock.hpp"
+#include "toposlam/pipeline/pipeline.hpp"
 #include "toposlam/segmentation/fiedler_segmenter.hpp"
 #include "toposlam/topology/sequence_loop_closures.hpp"
 #include "toposlam/topology/topology_particle_filter.hpp"
@@ -33,6 +34,9 @@ struct StageSettings {
   TopologyStageConfig topology_stage;          ///< topology.slice_items, topology.alternatives
   SequenceEvidenceConfig sequence_evidence;    ///< topology.sequence_evidence.* (docs/topology.md)
 };
+
+/// The localisation-only mode's settings (map.localize.*, with the map's similarity.*).
+NodeLocalizerConfig nodeLocalizerConfig(const NgramSimilarityConfig& similarity, const MapLocalizeConfig& localize);
 
 /// What the run publishes besides the places: the daemon's place events carry thumbnails, the offline
 /// commands keep none.

@@ -32,6 +32,8 @@ struct ClosedPlace {
   std::shared_ptr<const Fingerprint> representative;
   /// Other frames of the place (SegmentedPlace::samples) for the relative likelihood; may be empty.
   std::vector<std::shared_ptr<const Fingerprint>> samples;
+  /// Its views (SegmentedPlace::views): kept in the map for localisation only; no decision uses them.
+  std::vector<std::shared_ptr<const Fingerprint>> views;
   cv::Mat thumbnail;                      ///< small BGR image of the representative (may be empty)
   /// Sequence evidence (PlaceSequenceEvidence), one likelihood per earlier place of this run in closing
   /// order; empty when the segmentation stage has none.
@@ -176,6 +178,13 @@ class TopologyStage {
   virtual const PlaceEstimate& estimate() const = 0;
   /// The most probable topology as of the last finished step.
   virtual TopologySnapshot topology() const = 0;
+  /// True when the stage answers for every frame itself (localisation only): the pipeline then hands it
+  /// each frame's fingerprint with observeFrame() before reading estimate().
+  virtual bool observesFrames() const { return false; }
+  /// One frame of the stream, in order (only when observesFrames()).
+  virtual void observeFrame(const Fingerprint& /*fingerprint*/) {}
+  /// False when the map must never be written (localisation only).
+  virtual bool savesMap() const { return true; }
   /// Fills r.match_place and r.match_node for r.match_frame (both -1 when no finished place holds it).
   virtual void locate(RevisitEstimate& r) const {
     r.match_place = -1;
@@ -294,6 +303,8 @@ struct FrameResult {
   int keypoints = 0;
   double lambda2 = std::numeric_limits<double>::quiet_NaN();
   std::optional<ClosedPlace> closed_place;  ///< closed by segmentation on this frame (its step is queued)
+  /// The frame's fingerprint, carried to the topology stage only when it observes frames (localisation only).
+  std::shared_ptr<const Fingerprint> fingerprint;
   PlaceEstimate estimate;
   RevisitEstimate revisit;                     ///< whether this frame is back at an earlier one, and where
   std::vector<FinishedPlace> finished_places;  ///< steps finished on this frame

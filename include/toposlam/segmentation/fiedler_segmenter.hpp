@@ -137,6 +137,11 @@ struct FiedlerSegmenterConfig {
   /// "Place samples"). Allowed [0, kMaxQuerySamples]; 0 = the representative alone (the thesis).
   int place_samples = 0;
   static constexpr int kMaxQuerySamples = 16;
+  /// Besides its representative, a closed place keeps up to this many of its frames as views (picked as
+  /// the samples above, spread evenly over the place): the map stores them, and the localisation-only
+  /// mode recognises the place by them from any part of it (docs/daemon.md, "Localisation only"). They
+  /// change no mapping decision. Allowed [0, kMaxQuerySamples]; 0 = the representative alone.
+  int place_views = 0;
   /// Returns "" when valid, else "<key>: <problem, allowed range>".
   std::string validate() const;
 };
@@ -175,6 +180,8 @@ struct SegmentedPlace {
   /// FiedlerSegmenterConfig); a fixed array, so closing a place allocates nothing.
   std::array<std::shared_ptr<const Fingerprint>, FiedlerSegmenterConfig::kMaxQuerySamples> samples{};
   int sample_count = 0;
+  /// Up to place_views frames of the place (not the representative), in frame order, for the map.
+  std::vector<std::shared_ptr<const Fingerprint>> views;
   bool dropped = false;            ///< representative had fewer than min_keypoints keypoints
   /// Frame of the lambda2 valley that closed it, or (doorway_borders) the border frame of the doorway
   /// passage that did; -1 when flushed (the end of the stream).

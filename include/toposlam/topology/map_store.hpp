@@ -8,6 +8,9 @@
 //                                             FNV-1a 64 in versions 1 and 2 (still read)
 //   payload: bytes(filter state, TopologyParticleFilter::saveState) bytes(application data)
 //            bytes(settings)                                   (version 2 on; version 1 has none)
+//            bytes(views)                                      (version 5 on; earlier ones have none)
+// where views = u64 observations, then per observation u32 n and n times bytes(fingerprint): the frames
+// of each place kept besides its representative for the localisation-only mode (PlaceViews).
 // where bytes(x) = u64 size + x. The application data is opaque to MapStore (the `map` command keeps
 // its place/frame bookkeeping there). The settings are "key=value" lines that decide whether a map can
 // be continued by a run (the keypoint backend: ORB descriptors mean nothing to a SIFT run; the source,
@@ -54,7 +57,10 @@
 
 namespace toposlam {
 
-inline constexpr std::uint32_t kMapFormatVersion = 4;
+inline constexpr std::uint32_t kMapFormatVersion = 5;
+
+/// Per filter observation, the place's views (ClosedPlace::views; may be empty): no decision reads them.
+using PlaceViews = std::vector<std::vector<std::shared_ptr<const Fingerprint>>>;
 /// Default cap on a map file's size (bytes): a bigger file is refused before it is read. A map of 100
 /// places with 500 particles is about 1 MB.
 inline constexpr std::uint64_t kDefaultMaxMapBytes = 256ull << 20;
@@ -99,6 +105,7 @@ struct LoadedMap {
   std::unique_ptr<TopologyParticleFilter> filter;
   std::string application_data;
   MapSettings settings;  ///< empty for a version-1 file (recorded nothing)
+  PlaceViews views;      ///< one entry per observation (all empty before version 5)
 };
 
 /// The fixed header in front of the payload: magic, version, reserved, payload size, checksum (bytes).
@@ -133,11 +140,11 @@ namespace MapStore {
 
 /// The whole file image of `filter` (+ application data). Throws std::logic_error during a step.
 std::string encode(const TopologyParticleFilter& filter, std::string_view application_data = {},
-                   const MapSettings& settings = {});
+                   const MapSettings& settings = {}, const PlaceViews& views = {});
 /// The file image of a frozen state (TopologyParticleFilter::freeze()): what encode(filter) gave when
 /// it was frozen. Any thread (see FrozenTopologyState).
 std::string encode(const FrozenTopologyState& state, std::string_view application_data = {},
-                   const MapSettings& settings = {});
+                   const MapSettings& settings = {}, const PlaceViews& views = {});
 /// Parses a file image; `name` is used in error messages. Throws MapStoreError.
 LoadedMap decode(std::string_view file, const SimilarityMeasure& similarity, const std::string& name = "map");
 

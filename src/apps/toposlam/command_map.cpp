@@ -126,7 +126,8 @@ struct StartingFilter {
 /// what this run records for a source).
 StartingFilter resumedFilter(const MapOptions& o, ParticleFilterTopologyStage& topology,
                              const NgramSimilarity& similarity,
-                             const std::function<MapSettings(const std::string&)>& settings_for) {
+                             const std::function<MapSettings(const std::string&)>& settings_for, bool localizing) {
+  const bool other_source_allowed = o.resume_other_source || localizing;  // localising is a later run
   for (const char* key : {"topology.particles", "topology.alpha", "topology.seed", "topology.max_representatives_per_node"})
     if (keyGiven(o.config, key))
       throw std::invalid_argument(
@@ -143,7 +144,7 @@ StartingFilter resumedFilter(const MapOptions& o, ParticleFilterTopologyStage& t
     MapSettings current = settings_for(uri);
     std::string hint;
     if (settingDiffers(loaded.settings, current, "keypoints")) hint += "--keypoints";
-    if (o.resume_other_source)
+    if (other_source_allowed)
       current.erase(kMapSourceKey);
     else if (settingDiffers(loaded.settings, current, kMapSourceKey))
       hint += std::string(hint.empty() ? "" : "; ") + "--resume-other-source continues it from this source";
@@ -542,8 +543,16 @@ void runMap(const MapOptions& o) {
   const SequenceEvidenceConfig& evidence = config.sequence_evidence;
   ParticleFilterTopologyStage& topology = stages.topology();
   const auto settings_for = [&](const std::string& uri) { return mapSettingsOf(config, config.topology, uri); };
+  const bool localizing = config.map.mode == MapMode::Localize;
+  if (localizing && o.resume.empty())
+    throw ConfigError("map: map.mode is localize (--localize-only): give the map to localise in with --resume MAP");
   StartingFilter start;
-  if (!o.resume.empty()) start = resumedFilter(o, topology, similarity, settings_for);
+  if (!o.resume.empty()) start = resumedFilter(o, topology, similarity, settings_for, localizing);
+  if (localizing) {
+    topology.startLocalizing(nodeLocalizerConfig(config.similarity, config.map.localize));
+    std::cerr << "map: localising in " << o.resume << " (" << topology.topology().nodes.size()
+              << " nodes); it is not changed, and the run folder gets no map.tsm\n";
+  }
   const TopologyParticleFilter& filter = topology.filter();
   const int first_observation = filter.observationCount();
 
@@ -563,7 +572,9 @@ void runMap(const MapOptions& o) {
   const MapSettings made_with =
       mapSettingsOf(config, filter.config(), o.sources.front());  // the first traversal's source
   finishRunOrigins(start.origins, start.run_number, all);
-  MapStore::save(map_path, filter, encodeMapApplicationData(start.origins), made_with);
+  if (!localizing)
+    MapStore::writeAtomically(map_path, MapStore::encode(filter, encodeMapApplicationData(start.origins), made_with,
+                                                         topology.views()));
 
   // The most probable topology decides every place's node.
   const TopologyEstimate final_estimate = filter.estimate(3);
@@ -574,8 +585,15 @@ void runMap(const MapOptions& o) {
     for (const std::string& uri : o.sources) uris.push_back(absoluteSourceUri(uri));
     writeSources(out_dir, uris);
   }
-  const std::vector<FrameRecord> frame_rows = frameRowsWithLoopClosures(
+  std::vector<FrameRecord> frame_rows = frameRowsWithLoopClosures(
       runner, place_nodes, traversals.frame_fingerprints, similarity, evidence.frame_revisits, o.loop_min_gap);
+  if (localizing) {  // every frame's own answer, as toposlamd publishes it in place_t
+    const std::vector<OfflineRunner::FrameNode>& answers = runner.frameNodes();
+    for (std::size_t f = 0; f < frame_rows.size() && f < answers.size(); ++f) {
+      frame_rows[f].node = answers[f].node;
+      frame_rows[f].node_probability = answers[f].probability;
+    }
+  }
   traversals.frame_fingerprints.clear();
   writeFrames(out_dir, frame_rows, FrameColumns::WithLoopClosures);
   writePlaces(out_dir, placeRows(all.places, place_nodes));
@@ -607,6 +625,9 @@ void addMapCommand(CLI::App& app) {
   addConfigOptions(*cmd, options->config);
   addSegmentationOptions(*cmd, options->config);
   ConfigOptions& c = options->config;
+  addFlagAlias(*cmd, c, "--localize-only", "map.mode=localize",
+               "= --set map.mode=localize: localise every frame in the map given with --resume, which is never "
+               "changed (frames.csv's node is each frame's own answer; no map.tsm is written)");
   addKeyAlias(*cmd, c, "--particles", "topology.particles");
   addKeyAlias(*cmd, c, "--alpha", "topology.alpha");
   addKeyAlias(*cmd, c, "--seed", "topology.seed");

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -130,6 +131,18 @@ std::vector<fs::path> thumbnailPaths(const RunData& run, const std::vector<std::
     paths.push_back(path);
   }
   return paths;
+}
+
+/// The picture of frame `f`'s place (its representative's, read into `by_frame`), or "" when it has none.
+std::string placePicture(const RunData& run, std::int64_t f, const std::map<std::int64_t, std::string>& by_frame) {
+  const int place = run.frames[static_cast<std::size_t>(f)].place;
+  if (place < 0) return "";
+  for (const PlaceRecord& p : run.places) {
+    if (p.place != place) continue;
+    const auto it = by_frame.find(p.representative);
+    return it == by_frame.end() ? "" : it->second;
+  }
+  return "";
 }
 
 /// A picture of the run as BGR; empty when it cannot be read (the report shows it without).
@@ -249,12 +262,21 @@ void runReport(ReportCommandOptions o) {
   } else {
     const std::vector<std::int64_t> frames = eval::framesForThumbnails(in.run, o.thumbnails);
     const std::vector<fs::path> paths = thumbnailPaths(in.run, frames, folders);
-    int missing = 0;
-    for (std::size_t k = 0; k < frames.size(); ++k) {
-      std::string uri = paths[k].empty() ? "" : thumbnailDataUri(paths[k]);
+    // A frame without a picture of its own (toposlamd's log carries one per place, its representative's)
+    // shows its place's picture; only a frame with neither is missing.
+    std::map<std::int64_t, std::string> by_frame;
+    for (std::size_t k = 0; k < frames.size(); ++k)
+      if (!paths[k].empty()) by_frame[frames[k]] = thumbnailDataUri(paths[k]);
+    int missing = 0, from_place = 0;
+    for (const std::int64_t f : frames) {
+      std::string uri = by_frame.count(f) != 0 ? by_frame[f] : "";
+      if (uri.empty()) uri = placePicture(in.run, f, by_frame);
+      if (!uri.empty() && (by_frame.count(f) == 0 || by_frame[f].empty())) ++from_place;
       if (uri.empty()) ++missing;
-      in.thumbnails[static_cast<std::size_t>(frames[k])] = std::move(uri);
+      in.thumbnails[static_cast<std::size_t>(f)] = std::move(uri);
     }
+    if (from_place > 0)
+      std::cerr << "report: " << from_place << " frames without a picture of their own show their place's\n";
     if (missing > 0)
       in.warnings.push_back(std::to_string(missing) + " frames could not be read for thumbnails");
   }

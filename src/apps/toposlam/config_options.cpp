@@ -44,6 +44,15 @@ void addKeyAlias(CLI::App& command, ConfigOptions& options, const std::string& n
   options.aliases.push_back(std::move(alias));
 }
 
+void addFlagAlias(CLI::App& command, ConfigOptions& options, const std::string& name, const std::string& key_value,
+                  const std::string& help) {
+  auto alias = std::make_unique<ConfigAlias>();
+  alias->name = name;
+  alias->keys = {key_value};
+  alias->option = command.add_flag(name, help);
+  options.aliases.push_back(std::move(alias));
+}
+
 bool keyGiven(const ConfigOptions& options, const std::string& key) {
   for (const auto& alias : options.aliases) {
     if (alias->option->count() == 0) continue;

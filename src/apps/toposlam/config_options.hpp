@@ -41,6 +41,10 @@ void addKeyAlias(CLI::App& command, ConfigOptions& options, const std::string& n
 void addKeyAlias(CLI::App& command, ConfigOptions& options, const std::string& name, std::vector<std::string> keys,
                  std::vector<std::pair<std::string, std::string>> values, const std::string& help);
 
+/// A flag alias setting one key to a fixed value (`key_value` is "KEY=VALUE").
+void addFlagAlias(CLI::App& command, ConfigOptions& options, const std::string& name, const std::string& key_value,
+                  const std::string& help);
+
 /// True when the command line sets `key` (by an alias or --set).
 bool keyGiven(const ConfigOptions& options, const std::string& key);
 

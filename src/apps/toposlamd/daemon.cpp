@@ -299,6 +299,17 @@ std::string resolveMapPath(const std::string& path) {
   return path;
 }
 
+/// map.mode localize: the loaded map is localised in and never changed. Throws ConfigError (exit 2) when
+/// there is no map to localise in.
+void startLocalizing(const DaemonConfig& config, const std::string& map_path, ParticleFilterTopologyStage& topology) {
+  if (topology.observations() == 0)
+    throw ConfigError("map.mode is localize but no map with places loads from " + map_path +
+                      " (make one first with map.mode: map)");
+  topology.startLocalizing(nodeLocalizerConfig(config.similarity, config.map.localize));
+  spdlog::info("toposlamd: localising in {} ({} nodes); the map is never changed or saved", map_path,
+               topology.topology().nodes.size());
+}
+
 int runDaemon(const DaemonConfig& config) {
   const std::vector<int> signals = handledSignalNumbers();
   blockSignals(signals);        // before any thread exists: all inherit it
@@ -308,8 +319,19 @@ int runDaemon(const DaemonConfig& config) {
   SteadyClock clock;
   MapConfig map_config = config.map;
   map_config.path = resolveMapPath(config.map.path);
-  // A map that cannot be saved is found out now, not after a session of mapping.
-  checkMapSavable(map_config.path);
+  const bool localizing = config.map.mode == MapMode::Localize;
+  // A map that cannot be saved is found out now, not after a session of mapping (one localised in is never
+  // saved).
+  if (!localizing) checkMapSavable(map_config.path);
+  // Localisation only expects another source than the one the map was made from (a later run).
+  map_config.resume_other_source = map_config.resume_other_source || localizing;
+  if (localizing && (map_config.path.empty() || !config.map.load_at_start))
+    throw ConfigError("map.mode is localize: map.path must name the map to localise in, and map.load_at_start "
+                      "be true");
+  if (localizing && !std::filesystem::exists(map_config.path) &&
+      !std::filesystem::exists(MapStore::previousPath(map_config.path)))
+    throw ConfigError("map.mode is localize but there is no map at " + map_config.path +
+                      " (make one first with map.mode: map)");
 
   Assembly parts(config, clock, config.source);
   RecordingFrameSource* recording = startRecording(config.record, parts.source);
@@ -338,7 +360,7 @@ int runDaemon(const DaemonConfig& config) {
     for (const std::string& problem : recovered.problems) spdlog::error("toposlamd: cannot load a map: {}", problem);
     if (recovered.map) {
       const MapSettings recorded = recovered.map->settings;
-      const bool other_source = checkResumable(recorded, map_settings, config.map, recovered.loaded_from.string());
+      const bool other_source = checkResumable(recorded, map_settings, map_config, recovered.loaded_from.string());
       parts.stages.topology().adoptMap(std::move(*recovered.map));
       // From then on the map records this run's settings, with the filter's own from the map (they came
       // with it), and this source.
@@ -349,11 +371,12 @@ int runDaemon(const DaemonConfig& config) {
       spdlog::info("toposlamd: resumed the map {} ({} places){}", recovered.loaded_from.string(),
                    parts.stages.topology().observations(),
                    recovered.problems.empty() ? "" : ", the newest file that loads");
-      if (!other_source) continueSource(recorded, config, *parts.source, parts.stages.topology());
-    } else if (!recovered.problems.empty()) {
+      if (!other_source && !localizing) continueSource(recorded, config, *parts.source, parts.stages.topology());
+    } else if (!recovered.problems.empty() && !localizing) {
       spdlog::error("toposlamd: no map file of {} loads; starting a new map", map_config.path);
     }
   }
+  if (localizing) startLocalizing(config, map_config.path, parts.stages.topology());
 
   const double watchdog_s = config.watchdog.enabled ? notifier.watchdogPeriodSeconds() : 0.0;
   if (!waitForNetwork(config, signals, notifier, watchdog_s, clock)) return 0;

@@ -60,8 +60,8 @@ int main(int argc, char** argv) {
   for (const toposlam::ConfigKey& key : toposlam::daemonConfigKeys()) {
     if (key.option.empty()) continue;
     auto o = std::make_unique<Override>(Override{&key, nullptr, {}});
-    if (key.kind == toposlam::ConfigKind::Flag) {
-      o->text = key.option_sets ? "true" : "false";
+    if (key.kind == toposlam::ConfigKind::Flag || !key.option_value.empty()) {
+      o->text = !key.option_value.empty() ? key.option_value : key.option_sets ? "true" : "false";
       const std::string help = "set `" + key.path + "` to " + o->text + " (" + key.help + ")";
       o->option = app.add_flag(key.option, help);
     } else {
