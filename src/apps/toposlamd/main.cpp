@@ -1,6 +1,7 @@
 // toposlamd: the real-time topological SLAM service. Reads one config (default
-// $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
-// runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
+// $CONFIGURATION_DIRECTORY/toposlam.yaml, then the install's <sysconfdir>/toposlam/toposlam.yaml, then
+// /etc/toposlam/toposlam.yaml, else built-in defaults: config_path.hpp), runs the pipeline and publishes
+// over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
 #include <csignal>
 #include <exception>
 #include <filesystem>
