@@ -31,6 +31,7 @@
 
 #include "bench.hpp"
 #include "bridge_config.hpp"
+#include "config_key_cli.hpp"
 #include "toposlam/config/config_path.hpp"
 #include "toposlam/config/config_reader.hpp"
 #include "toposlam/firmware/emulator.hpp"
@@ -265,22 +266,7 @@ int main(int argc, char** argv) {
                  "config file (YAML; keys: --help-config). Default: " +
                      toposlam::defaultConfigPath("toposlam-bridge.yaml") + " if it exists, else built-in defaults");
   // The options that set a key come from the key table (bridge_config.cpp), as toposlamd's do.
-  struct Override {
-    const bridge::BridgeConfigKey* key;
-    CLI::Option* option;
-    std::string text;
-  };
-  std::vector<std::unique_ptr<Override>> overrides;
-  for (const bridge::BridgeConfigKey& key : bridge::bridgeConfigKeys()) {
-    if (key.option.empty()) continue;
-    auto o = std::make_unique<Override>(Override{&key, nullptr, {}});
-    o->option = app.add_option(key.option, o->text,
-                               "override `" + key.path + "`: " + key.help + " (" + key.rangeText() + ")");
-    if (key.kind == ConfigKind::Choice) o->option->check(CLI::IsMember(key.choices));
-    if (key.kind == ConfigKind::Integer) o->option->type_name("INT");
-    if (key.kind == ConfigKind::Real) o->option->type_name("NUMBER");
-    overrides.push_back(std::move(o));
-  }
+  const cli::ConfigKeyOptions<bridge::BridgeConfig> key_options(app, bridge::bridgeConfigKeys());
   std::vector<std::string> sets;
   app.add_option("--set", sets,
                  "set any key of the config: --set KEY=VALUE (repeatable; keys and values as in the YAML, "
@@ -345,15 +331,10 @@ int main(int argc, char** argv) {
     if (!explicit_config) config_path = toposlam::defaultConfigPath("toposlam-bridge.yaml");
     const bool read_file = explicit_config || std::filesystem::exists(config_path);
     std::vector<ConfigOverride> given;
-    const auto option_given = [&](const std::string& path) {
-      for (const auto& o : overrides)
-        if (o->key->path == path && o->option->count() > 0) return true;
-      return false;
-    };
     // --udp alone replaces the file's serial device: a UDP link has none.
-    if (option_given("link.udp_port") && !option_given("link.serial")) given.push_back({"link.serial", "", "--udp"});
-    for (const auto& o : overrides)
-      if (o->option->count() > 0) given.push_back({o->key->path, o->text, o->key->option});
+    if (key_options.given("link.udp_port") && !key_options.given("link.serial"))
+      given.push_back({"link.serial", "", "--udp"});
+    for (const ConfigOverride& o : key_options.overrides()) given.push_back(o);
     for (const std::string& set : sets)
       given.push_back(parseSetAssignment(configKeySpecs(bridge::bridgeConfigKeys()), set, "link.baud=57600",
                                          "toposlam-bridge --help-config"));
