@@ -8,17 +8,19 @@ namespace toposlam::bridge {
 
 namespace {
 
+// The member a key lands in, for const and non-const configs alike.
 #define AT(member) [](auto& c) -> auto& { return c.member; }
 
 struct BridgeKeyTable : ConfigKeyBuilders<BridgeConfig> {
   static std::vector<BridgeConfigKey> makeKeys() {
     const BridgeConfig d;  // the defaults are the structs' own
     std::vector<BridgeConfigKey> k;
-    k.push_back(choice("link.protocol", AT(link.protocol), d.link.protocol,
-                       {{"wheel", firmware::LinkProtocol::Wheel}, {"mavlink", firmware::LinkProtocol::Mavlink}},
-                       "the controller's protocol: wheel (the toposlam wheel link, firmware-host/PROTOCOL.md) or "
-                       "mavlink (MAVLink 2)")
-                    .withOption("--protocol"));
+    k.push_back(
+        choice("link.protocol", AT(link.protocol), d.link.protocol,
+               {{"wheel", firmware::LinkProtocol::Wheel}, {"mavlink", firmware::LinkProtocol::Mavlink}},
+               "the controller's protocol: wheel (the toposlam wheel link, firmware-host/PROTOCOL.md) or "
+               "mavlink (MAVLink 2)")
+            .withOption("--protocol"));
     k.push_back(text("link.serial", AT(link.serial), d.link.serial, 0, 4096,
                      "serial device of the controller, e.g. /dev/ttyACM0 or /dev/serial/by-id/...; \"\" with "
                      "link.udp_port")
@@ -48,22 +50,24 @@ struct BridgeKeyTable : ConfigKeyBuilders<BridgeConfig> {
                      "seconds between status lines")
                     .withNote("0 = only at exit")
                     .withOption("--status-period"));
-    k.push_back(real("status.link_timeout_s", AT(status.link_timeout_s), d.status.link_timeout_s, 0.1, 60, "seconds",
-                     "no valid frame for this long: the link is reported silent or garbage"));
-    k.push_back(real("motion.moving_speed_mps", AT(motion.moving_speed_mps), d.motion.moving_speed_mps, 0, 10, "m/s",
-                     "faster counts as moving"));
-    k.push_back(real("motion.moving_turn_rps", AT(motion.moving_turn_rps), d.motion.moving_turn_rps, 0, 10, "rad/s",
-                     "turning faster counts as moving"));
+    k.push_back(real("status.link_timeout_s", AT(status.link_timeout_s), d.status.link_timeout_s, 0.1, 60,
+                     "seconds", "no valid frame for this long: the link is reported silent or garbage"));
+    k.push_back(real("motion.moving_speed_mps", AT(motion.moving_speed_mps), d.motion.moving_speed_mps, 0, 10,
+                     "m/s", "faster counts as moving"));
+    k.push_back(real("motion.moving_turn_rps", AT(motion.moving_turn_rps), d.motion.moving_turn_rps, 0, 10,
+                     "rad/s", "turning faster counts as moving"));
     k.push_back(real("motion.max_gap_s", AT(motion.max_gap_s), d.motion.max_gap_s, 0.01, 10, "seconds",
                      "body-velocity samples further apart are not integrated"));
-    k.push_back(real("motion.max_speed_mps", AT(motion.max_speed_mps), d.motion.max_speed_mps, 0.1, 1000, "m/s",
-                     "a sample faster, or an increment longer than this speed allows, is refused and counted"));
-    k.push_back(real("motion.max_turn_rate_rps", AT(motion.max_turn_rate_rps), d.motion.max_turn_rate_rps, 0.1, 1000,
-                     "rad/s", "a sample turning faster is refused and counted"));
-    k.push_back(real("motion.clock_tolerance_s", AT(motion.clock_tolerance_s), d.motion.clock_tolerance_s, 0.01, 3600,
-                     "seconds",
-                     "the controller's clock running ahead of the host's by more is refused and counted (a jump "
-                     "that lasts longer is a restart); the published time falling behind by more is re-estimated"));
+    k.push_back(
+        real("motion.max_speed_mps", AT(motion.max_speed_mps), d.motion.max_speed_mps, 0.1, 1000, "m/s",
+             "a sample faster, or an increment longer than this speed allows, is refused and counted"));
+    k.push_back(real("motion.max_turn_rate_rps", AT(motion.max_turn_rate_rps), d.motion.max_turn_rate_rps,
+                     0.1, 1000, "rad/s", "a sample turning faster is refused and counted"));
+    k.push_back(
+        real("motion.clock_tolerance_s", AT(motion.clock_tolerance_s), d.motion.clock_tolerance_s, 0.01, 3600,
+             "seconds",
+             "the controller's clock running ahead of the host's by more is refused and counted (a jump "
+             "that lasts longer is a restart); the published time falling behind by more is re-estimated"));
     return k;
   }
 };
@@ -121,12 +125,16 @@ std::string bridgeConfigYaml(const BridgeConfig& config, bool comments) {
 }
 
 std::string shippedBridgeConfigYaml() {
-  return "# toposlam-bridge.yaml: the config of toposlam-bridge (installed as /etc/toposlam/toposlam-bridge.yaml;\n"
-         "# with systemd, ConfigurationDirectory=toposlam makes it $CONFIGURATION_DIRECTORY/toposlam-bridge.yaml).\n"
+  return "# toposlam-bridge.yaml: the config of toposlam-bridge (installed as "
+         "/etc/toposlam/toposlam-bridge.yaml;\n"
+         "# with systemd, ConfigurationDirectory=toposlam makes it "
+         "$CONFIGURATION_DIRECTORY/toposlam-bridge.yaml).\n"
          "#\n"
-         "# Made from the bridge's key table (firmware-host/bridge/bridge_config.cpp); test_bridge_config checks\n"
+         "# Made from the bridge's key table (firmware-host/bridge/bridge_config.cpp); test_bridge_config "
+         "checks\n"
          "# that this file is what the table makes, so change a key's help or default there.\n"
-         "# Every key is optional: an absent key keeps the default shown. Unknown or repeated keys, wrong types\n"
+         "# Every key is optional: an absent key keeps the default shown. Unknown or repeated keys, wrong "
+         "types\n"
          "# and out-of-range values are refused at start with the key's dotted name and its range. Options\n"
          "# (--serial, --baud, ..., --set KEY=VALUE) override the file. Set link.serial (or link.udp_port)\n"
          "# before starting the service. Check a file: toposlam-bridge --check-config -c FILE; every key's\n"

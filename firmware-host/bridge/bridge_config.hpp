@@ -17,10 +17,10 @@ namespace toposlam::bridge {
 /// link: where the controller's bytes come from.
 struct BridgeLinkConfig {
   firmware::LinkProtocol protocol = firmware::LinkProtocol::Wheel;  ///< wheel | mavlink
-  std::string serial;                    ///< device path ("" with udp_port)
-  int baud = 115200;                     ///< serial baud rate
+  std::string serial;                                               ///< device path ("" with udp_port)
+  int baud = 115200;                                                ///< serial baud rate
   std::string udp_address = "127.0.0.1";  ///< address bound for MAVLink over UDP (from a router)
-  int udp_port = 0;                      ///< 0 = the serial device
+  int udp_port = 0;                       ///< 0 = the serial device
 };
 
 /// lcm: where the motion goes.

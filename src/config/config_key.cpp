@@ -21,7 +21,8 @@ std::string ConfigKeySpec::rangeText() const {
       range = std::to_string(integer_low) + " .. " + std::to_string(integer_high);
       break;
     case ConfigKind::Real:
-      range = std::string(low_open ? "(" : "[") + configRangeNumber(low) + ", " + configRangeNumber(high) + (high_open ? ")" : "]");
+      range = std::string(low_open ? "(" : "[") + configRangeNumber(low) + ", " + configRangeNumber(high) +
+              (high_open ? ")" : "]");
       break;
     case ConfigKind::Flag:
       range = "true or false";
@@ -58,8 +59,8 @@ std::string ConfigKeySpec::problem(const ConfigValue& value) const {
       const std::string& v = std::get<std::string>(value);
       if (v.size() >= min_length && v.size() <= max_length) return "";
       if (v.empty() && !example.empty()) return "must not be empty (e.g. " + example + ")";
-      return "must have " + std::to_string(min_length) + " to " + std::to_string(max_length) + " characters, got '" +
-             v + "'";
+      return "must have " + std::to_string(min_length) + " to " + std::to_string(max_length) +
+             " characters, got '" + v + "'";
     }
     case ConfigKind::Choice: {
       const std::string& v = std::get<std::string>(value);
@@ -106,6 +107,5 @@ double ConfigKeySpec::defaultNumber() const {
   if (kind == ConfigKind::Real) return std::get<double>(default_value);
   throw std::logic_error("config key " + path + " is not a number");
 }
-
 
 }  // namespace toposlam

@@ -40,13 +40,15 @@ ConfigValue valueOf(const ConfigKeySpec& key, const YAML::Node& node) {
         const std::size_t digits = text.find_first_not_of("+-");
         if (digits != std::string::npos && text.size() > digits + 1 && text[digits] == '0' &&
             text.find_first_not_of("0123456789", digits) == std::string::npos)
-          throw ConfigError(path + ": '" + text + "' has a leading zero (read as octal by some YAML readers, as "
+          throw ConfigError(path + ": '" + text +
+                            "' has a leading zero (read as octal by some YAML readers, as "
                             "decimal by others); write it without");
       }
       try {
         return node.as<long long>();
       } catch (const YAML::Exception&) {
-        throw ConfigError(path + ": expected an integer in " + key.rangeText() + ", got " + describeNode(node));
+        throw ConfigError(path + ": expected an integer in " + key.rangeText() + ", got " +
+                          describeNode(node));
       }
     case ConfigKind::Real:
       try {
@@ -71,20 +73,20 @@ ConfigValue valueOf(const ConfigKeySpec& key, const YAML::Node& node) {
   throw ConfigError(path + ": unknown kind of key");
 }
 
-
 // Reads one key's value: refused when it has none, is of the wrong kind or out of range (checked before
 // it is stored, so a too large integer is never narrowed into the member).
 ConfigValue readValue(const ConfigKeySpec& key, const YAML::Node& node) {
   if (node.IsNull()) throw ConfigError(key.path + ": has no value (remove the key to keep the default)");
   if (node.IsMap()) throw ConfigError(key.path + ": expected a value, got a mapping");
   const ConfigValue value = valueOf(key, node);
-  if (std::string problem = key.problem(value); !problem.empty()) throw ConfigError(key.path + ": " + problem);
+  if (std::string problem = key.problem(value); !problem.empty())
+    throw ConfigError(key.path + ": " + problem);
   return value;
 }
 
 // A key table seen as a tree: the keys and the sections (mappings) at each path.
 struct KeyTree {
-  std::map<std::string, std::size_t> keys;                 // full path -> index in the table
+  std::map<std::string, std::size_t> keys;                // full path -> index in the table
   std::map<std::string, std::set<std::string>> children;  // section path ("" = top level) -> child names
 
   explicit KeyTree(const std::vector<const ConfigKeySpec*>& table) {
@@ -93,8 +95,9 @@ struct KeyTree {
       keys[path] = i;
       std::string section;
       std::size_t begin = 0;
-      for (std::size_t dot = path.find('.'); ; dot = path.find('.', begin)) {
-        const std::string name = path.substr(begin, dot == std::string::npos ? std::string::npos : dot - begin);
+      for (std::size_t dot = path.find('.');; dot = path.find('.', begin)) {
+        const std::string name =
+            path.substr(begin, dot == std::string::npos ? std::string::npos : dot - begin);
         children[section].insert(name);
         if (dot == std::string::npos) break;
         section = joinPath(section, name);
@@ -152,7 +155,8 @@ int yamlDocumentCount(const std::string& text) {
     const bool blank = first == std::string::npos || line[first] == '#';
     if (start) {
       if (content || ended || documents == 0) ++documents;
-      content = line.find_first_not_of(" \t", 3) != std::string::npos && line[line.find_first_not_of(" \t", 3)] != '#';
+      content = line.find_first_not_of(" \t", 3) != std::string::npos &&
+                line[line.find_first_not_of(" \t", 3)] != '#';
       ended = false;
     } else if (end) {
       ended = true;
@@ -177,9 +181,11 @@ class AliasRefuser final : public YAML::EventHandler {
     if (first_alias_line < 0) first_alias_line = mark.line + 1;  // noted, not thrown through yaml-cpp
   }
   void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
-  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
   void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+  }
   void OnMapEnd() override {}
   int first_alias_line = -1;
 };
@@ -213,7 +219,6 @@ void refuseDuplicateKeys(const YAML::Node& node, const std::string& path) {
   }
 }
 
-
 constexpr std::size_t kLineWidth = 110;
 
 // The section part of a key path ("a.b" of "a.b.c"; "" at the top level).
@@ -233,8 +238,10 @@ std::vector<std::string> split(const std::string& path) {
 
 }  // namespace
 
-void readConfigYaml(const std::string& text, const std::string& origin, const std::vector<const ConfigKeySpec*>& keys,
-                    const std::function<void(std::size_t, const ConfigValue&)>& set, const ConfigReadOrder& order) {
+void readConfigYaml(const std::string& text, const std::string& origin,
+                    const std::vector<const ConfigKeySpec*>& keys,
+                    const std::function<void(std::size_t, const ConfigValue&)>& set,
+                    const ConfigReadOrder& order) {
   YAML::Node root;
   try {
     // A second document ("---") would be ignored silently by YAML::Load: refused instead. Found by
@@ -253,7 +260,8 @@ void readConfigYaml(const std::string& text, const std::string& origin, const st
   const KeyTree tree(keys);
   try {
     refuseDuplicateKeys(root, "");
-    // The first key, wherever it is written: it gives the other keys' defaults, which the text then overrides.
+    // The first key, wherever it is written: it gives the other keys' defaults, which the text then
+    // overrides.
     if (!order.first.empty() && !order.skip_first && root.IsMap()) {
       const YAML::Node& map = root;  // const look-up: the non-const operator[] would insert the key
       if (const YAML::Node node = map[order.first]; node.IsDefined()) {
@@ -275,21 +283,23 @@ std::string readConfigFile(const std::string& path, const std::string& file_name
     throw ConfigError("the config file '" + path + "' is a folder; give the YAML file in it (e.g. " +
                       (std::filesystem::path(path) / file_name).string() + ")");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError("cannot read the config file '" + path + "' (does it exist and is it readable?)");
+  if (!in)
+    throw ConfigError("cannot read the config file '" + path + "' (does it exist and is it readable?)");
   // Read at most the cap (+1 to notice more): /dev/zero or a runaway file never reads forever.
   std::string text(kMaxConfigBytes + 1, '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw ConfigError("cannot read the config file '" + path + "'");
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxConfigBytes)
-    throw ConfigError("the config file '" + path + "' is larger than " + std::to_string(kMaxConfigBytes >> 10) +
-                      " KiB; is it really a " + file_name + "?");
+    throw ConfigError("the config file '" + path + "' is larger than " +
+                      std::to_string(kMaxConfigBytes >> 10) + " KiB; is it really a " + file_name + "?");
   return text;
 }
 
 ConfigValue configValueFromText(const ConfigKeySpec& key, const std::string& text) {
   const ConfigValue value = valueOf(key, YAML::Node(text));
-  if (std::string problem = key.problem(value); !problem.empty()) throw ConfigError(key.path + ": " + problem);
+  if (std::string problem = key.problem(value); !problem.empty())
+    throw ConfigError(key.path + ": " + problem);
   return value;
 }
 
@@ -299,8 +309,9 @@ bool isConfigSection(const std::vector<const ConfigKeySpec*>& keys, const std::s
   return false;
 }
 
-ConfigOverride parseSetAssignment(const std::vector<const ConfigKeySpec*>& keys, const std::string& assignment,
-                                  const std::string& example, const std::string& keys_listed) {
+ConfigOverride parseSetAssignment(const std::vector<const ConfigKeySpec*>& keys,
+                                  const std::string& assignment, const std::string& example,
+                                  const std::string& keys_listed) {
   const std::size_t equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0)
     throw ConfigError("command line: --set " + assignment + ": expected KEY=VALUE, e.g. --set " + example);
@@ -310,8 +321,8 @@ ConfigOverride parseSetAssignment(const std::vector<const ConfigKeySpec*>& keys,
   if (!known) {
     std::string hint;
     if (isConfigSection(keys, o.path)) hint = " ('" + o.path + "' is a section; name one of its keys)";
-    throw ConfigError("command line: --set " + assignment + ": unknown key '" + o.path + "'" + hint + " (the keys: " +
-                      keys_listed + ")");
+    throw ConfigError("command line: --set " + assignment + ": unknown key '" + o.path + "'" + hint +
+                      " (the keys: " + keys_listed + ")");
   }
   return o;
 }

@@ -28,12 +28,14 @@ SCENARIO("config path: candidates are the unit's directory, the install's own, t
           std::vector<std::string>{"/srv/tsl/etc/toposlam/toposlam.yaml", "/etc/toposlam/toposlam.yaml"});
     CHECK(configPathCandidates("toposlam-bridge.yaml", "/usr/bin/toposlam-bridge") ==
           std::vector<std::string>{"/etc/toposlam/toposlam-bridge.yaml"});
-    CHECK(configPathCandidates("toposlam.yaml", "") == std::vector<std::string>{"/etc/toposlam/toposlam.yaml"});
+    CHECK(configPathCandidates("toposlam.yaml", "") ==
+          std::vector<std::string>{"/etc/toposlam/toposlam.yaml"});
   }
   GIVEN("systemd's CONFIGURATION_DIRECTORY with two entries") {
     setenv("CONFIGURATION_DIRECTORY", "/etc/toposlam:/etc/other", 1);
     CHECK(configPathCandidates("toposlam-bridge.yaml", "/usr/local/bin/toposlam-bridge") ==
-          std::vector<std::string>{"/etc/toposlam/toposlam-bridge.yaml", "/usr/local/etc/toposlam/toposlam-bridge.yaml",
+          std::vector<std::string>{"/etc/toposlam/toposlam-bridge.yaml",
+                                   "/usr/local/etc/toposlam/toposlam-bridge.yaml",
                                    "/etc/toposlam/toposlam-bridge.yaml"});
     unsetenv("CONFIGURATION_DIRECTORY");
   }

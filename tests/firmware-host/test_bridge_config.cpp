@@ -34,7 +34,8 @@ std::string errorOf(const std::string& yaml) {
 
 }  // namespace
 
-SCENARIO("firmware-host: the bridge's key table holds the structs' defaults and reads each key into its member") {
+SCENARIO(
+    "firmware-host: the bridge's key table holds the structs' defaults and reads each key into its member") {
   GIVEN("the default BridgeConfig and MotionEstimatorConfig") {
     const BridgeConfig defaults;
     THEN("every key's default is the member's default value") {
@@ -50,9 +51,10 @@ SCENARIO("firmware-host: the bridge's key table holds the structs' defaults and 
   }
   WHEN("a file sets keys of every section") {
     BridgeConfig c;
-    readConfigText("link:\n  protocol: mavlink\n  udp_port: 14550\nlcm:\n  channel: MOTION_B\n"
-                   "status:\n  period_s: 0\nmotion:\n  max_gap_s: 0.25\n",
-                   "test.yaml", bridgeConfigKeys(), c);
+    readConfigText(
+        "link:\n  protocol: mavlink\n  udp_port: 14550\nlcm:\n  channel: MOTION_B\n"
+        "status:\n  period_s: 0\nmotion:\n  max_gap_s: 0.25\n",
+        "test.yaml", bridgeConfigKeys(), c);
     THEN("each lands in the member of its path; the others keep their defaults") {
       CHECK(c.link.protocol == firmware::LinkProtocol::Mavlink);
       CHECK(c.link.udp_port == 14550);
@@ -73,8 +75,10 @@ SCENARIO("firmware-host: the bridge's config refuses what the table does not all
   CHECK_THAT(errorOf("link:\n  protocol: can\n"), Catch::Contains("link.protocol: 'can' is not allowed"));
   CHECK_THAT(errorOf("status:\n  link_timeout_s: 0\n"),
              Catch::Contains("status.link_timeout_s: 0 is out of range, allowed [0.1, 60] seconds"));
-  CHECK_THAT(errorOf("link:\n  sreial: /dev/ttyACM0\n"), Catch::Contains("unknown key 'link.sreial' (line 2"));
-  CHECK_THAT(errorOf("motion:\n  max_gap_s: 1\nmotion:\n  max_gap_s: 2\n"), Catch::Contains("duplicate key 'motion'"));
+  CHECK_THAT(errorOf("link:\n  sreial: /dev/ttyACM0\n"),
+             Catch::Contains("unknown key 'link.sreial' (line 2"));
+  CHECK_THAT(errorOf("motion:\n  max_gap_s: 1\nmotion:\n  max_gap_s: 2\n"),
+             Catch::Contains("duplicate key 'motion'"));
   BridgeConfig no_link;
   CHECK_THAT(linkProblem(no_link), Catch::StartsWith("no link"));
   no_link.link.udp_port = 14550;
@@ -93,8 +97,11 @@ SCENARIO("firmware-host: command-line overrides go through the same table after 
                     Catch::Contains("cannot read the config file '/nonexistent/toposlam-bridge.yaml'"));
 }
 
-SCENARIO("firmware-host: the shipped toposlam-bridge.yaml is what the table makes, and reads back to the defaults") {
-  const std::string shipped = readFile(std::string(TOPOSLAM_SOURCE_DIR) + "/firmware-host/bridge/toposlam-bridge.yaml");
+SCENARIO(
+    "firmware-host: the shipped toposlam-bridge.yaml is what the table makes, and reads back to the "
+    "defaults") {
+  const std::string shipped =
+      readFile(std::string(TOPOSLAM_SOURCE_DIR) + "/firmware-host/bridge/toposlam-bridge.yaml");
   // On a difference: `toposlam-bridge --shipped-config > firmware-host/bridge/toposlam-bridge.yaml`.
   CHECK(shipped == shippedBridgeConfigYaml());
   BridgeConfig read;

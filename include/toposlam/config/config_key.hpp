@@ -42,9 +42,9 @@ struct ConfigKeySpec {
   long long integer_low = 0, integer_high = 0;
   double low = 0.0, high = 0.0;
   bool low_open = false, high_open = false;
-  std::vector<std::string> choices;  ///< Choice: the allowed names
+  std::vector<std::string> choices;            ///< Choice: the allowed names
   std::size_t min_length = 0, max_length = 0;  ///< Text
-  std::string example;  ///< Text: said when an empty value is refused
+  std::string example;                         ///< Text: said when an empty value is refused
   /// The program's option overriding the key ("" = none). A Flag's option sets `option_sets`.
   std::string option;
   bool option_sets = true;
@@ -79,10 +79,24 @@ struct BasicConfigKey : ConfigKeySpec {
   std::function<void(Config&, const ConfigValue&)> set;
 
   // Table-building helpers (chainable).
-  BasicConfigKey& withNote(std::string text) { note = std::move(text); return *this; }
-  BasicConfigKey& withOption(std::string name, bool sets = true) { option = std::move(name); option_sets = sets; return *this; }
-  BasicConfigKey& withCrossCheck(std::function<std::string(const Config&)> check) { cross_check = std::move(check); return *this; }
-  BasicConfigKey& exclusive(bool low_end, bool high_end) { low_open = low_end; high_open = high_end; return *this; }
+  BasicConfigKey& withNote(std::string text) {
+    note = std::move(text);
+    return *this;
+  }
+  BasicConfigKey& withOption(std::string name, bool sets = true) {
+    option = std::move(name);
+    option_sets = sets;
+    return *this;
+  }
+  BasicConfigKey& withCrossCheck(std::function<std::string(const Config&)> check) {
+    cross_check = std::move(check);
+    return *this;
+  }
+  BasicConfigKey& exclusive(bool low_end, bool high_end) {
+    low_open = low_end;
+    high_open = high_end;
+    return *this;
+  }
 };
 
 /// A section (YAML mapping) of a config, with its comment in the generated YAML and docs.
@@ -107,8 +121,8 @@ struct ConfigKeyBuilders {
   }
 
   template <typename Access>
-  static Key integer(std::string path, Access access, long long def, long long lo, long long hi, std::string unit,
-                     std::string help) {
+  static Key integer(std::string path, Access access, long long def, long long lo, long long hi,
+                     std::string unit, std::string help) {
     Key k = base(std::move(path), ConfigKind::Integer, std::move(unit), std::move(help));
     k.default_value = def;
     k.integer_low = lo;
@@ -146,8 +160,8 @@ struct ConfigKeyBuilders {
 
   /// A string of min_length .. max_length characters.
   template <typename Access>
-  static Key text(std::string path, Access access, std::string def, std::size_t min_length, std::size_t max_length,
-                  std::string help) {
+  static Key text(std::string path, Access access, std::string def, std::size_t min_length,
+                  std::size_t max_length, std::string help) {
     Key k = base(std::move(path), ConfigKind::Text, "", std::move(help));
     k.default_value = std::move(def);
     k.min_length = min_length;
@@ -159,8 +173,8 @@ struct ConfigKeyBuilders {
 
   /// One of `names`, each naming a value of the member (an enum or a string).
   template <typename Access, typename Value>
-  static Key choice(std::string path, Access access, Value def, std::vector<std::pair<std::string, Value>> names,
-                    std::string help) {
+  static Key choice(std::string path, Access access, Value def,
+                    std::vector<std::pair<std::string, Value>> names, std::string help) {
     Key k = base(std::move(path), ConfigKind::Choice, "", std::move(help));
     for (const auto& [name, value] : names) {
       k.choices.push_back(name);
@@ -179,8 +193,8 @@ struct ConfigKeyBuilders {
   }
 
   template <typename Access>
-  static Key choice(std::string path, Access access, const std::string& def, const std::vector<std::string>& names,
-                    std::string help) {
+  static Key choice(std::string path, Access access, const std::string& def,
+                    const std::vector<std::string>& names, std::string help) {
     std::vector<std::pair<std::string, std::string>> pairs;
     for (const std::string& n : names) pairs.emplace_back(n, n);
     return choice(std::move(path), access, def, pairs, std::move(help));
@@ -192,7 +206,8 @@ struct ConfigKeyBuilders {
 template <typename Config>
 std::string configKeysProblem(const std::vector<BasicConfigKey<Config>>& keys, const Config& config) {
   for (const auto& key : keys)
-    if (std::string problem = key.problem(key.get(config)); !problem.empty()) return key.path + ": " + problem;
+    if (std::string problem = key.problem(key.get(config)); !problem.empty())
+      return key.path + ": " + problem;
   for (const auto& key : keys)
     if (key.cross_check)
       if (std::string problem = key.cross_check(config); !problem.empty()) return key.path + ": " + problem;

@@ -29,8 +29,10 @@ struct ConfigReadOrder {
 /// the key's kind and in its range. ConfigError "<origin>: <problem>" for more than one document, an alias,
 /// a repeated or unknown key (with its line and the known keys of its section), a value of the wrong kind
 /// or out of range.
-void readConfigYaml(const std::string& text, const std::string& origin, const std::vector<const ConfigKeySpec*>& keys,
-                    const std::function<void(std::size_t, const ConfigValue&)>& set, const ConfigReadOrder& order = {});
+void readConfigYaml(const std::string& text, const std::string& origin,
+                    const std::vector<const ConfigKeySpec*>& keys,
+                    const std::function<void(std::size_t, const ConfigValue&)>& set,
+                    const ConfigReadOrder& order = {});
 
 /// The text of the config file at `path`: ConfigError if it cannot be read, is a folder (naming
 /// `file_name`, the file expected in it) or is over kMaxConfigBytes.
@@ -68,8 +70,9 @@ struct ConfigOverride {
 /// The override of `--set KEY=VALUE` (`assignment` is "KEY=VALUE") against `keys`; ConfigError "command
 /// line: --set TEXT: ..." when it has no '=' (`example` is a correct one) or KEY is no key of the table
 /// (`keys_listed` says where the keys are listed, e.g. "docs/config.md").
-ConfigOverride parseSetAssignment(const std::vector<const ConfigKeySpec*>& keys, const std::string& assignment,
-                                  const std::string& example, const std::string& keys_listed);
+ConfigOverride parseSetAssignment(const std::vector<const ConfigKeySpec*>& keys,
+                                  const std::string& assignment, const std::string& example,
+                                  const std::string& keys_listed);
 
 // --- A table of BasicConfigKey<Config>. ---
 
@@ -84,10 +87,12 @@ std::vector<const ConfigKeySpec*> configKeySpecs(const std::vector<BasicConfigKe
 /// Reads YAML `text` onto `config` (readConfigYaml); ranges are checked, cross-key constraints are not
 /// (configKeysProblem).
 template <typename Config>
-void readConfigText(const std::string& text, const std::string& origin, const std::vector<BasicConfigKey<Config>>& keys,
-                    Config& config, const ConfigReadOrder& order = {}) {
-  readConfigYaml(text, origin, configKeySpecs(keys),
-                 [&](std::size_t i, const ConfigValue& value) { keys[i].set(config, value); }, order);
+void readConfigText(const std::string& text, const std::string& origin,
+                    const std::vector<BasicConfigKey<Config>>& keys, Config& config,
+                    const ConfigReadOrder& order = {}) {
+  readConfigYaml(
+      text, origin, configKeySpecs(keys),
+      [&](std::size_t i, const ConfigValue& value) { keys[i].set(config, value); }, order);
 }
 
 /// Sets the key at `path` of `keys` from its text; ConfigError naming the key for a bad value, or "unknown
@@ -106,8 +111,8 @@ void setConfigKey(const std::vector<BasicConfigKey<Config>>& keys, Config& confi
 /// `config` as YAML with every key of `keys`; with `comments`, each key's configKeyComment and each
 /// section's help from `sections`.
 template <typename Config>
-std::string configKeysYaml(const std::vector<BasicConfigKey<Config>>& keys, const std::vector<ConfigSection>& sections,
-                           const Config& config, bool comments) {
+std::string configKeysYaml(const std::vector<BasicConfigKey<Config>>& keys,
+                           const std::vector<ConfigSection>& sections, const Config& config, bool comments) {
   std::function<std::string(std::size_t)> comment;
   if (comments) comment = [&](std::size_t i) { return configKeyComment(keys[i]); };
   return configYamlText(

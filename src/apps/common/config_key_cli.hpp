@@ -30,8 +30,9 @@ class ConfigKeyOptions {
         const std::string help = "set `" + key.path + "` to " + entry->text + " (" + key.help + ")";
         entry->option = app.add_flag(key.option, help);
       } else {
-        entry->option = app.add_option(key.option, entry->text,
-                                       "override `" + key.path + "`: " + key.help + " (" + key.rangeText() + ")");
+        entry->option =
+            app.add_option(key.option, entry->text,
+                           "override `" + key.path + "`: " + key.help + " (" + key.rangeText() + ")");
         if (key.kind == ConfigKind::Choice) entry->option->check(CLI::IsMember(key.choices));
         if (key.kind == ConfigKind::Integer) entry->option->type_name("INT");
         if (key.kind == ConfigKind::Real) entry->option->type_name("NUMBER");
