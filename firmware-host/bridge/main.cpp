@@ -5,6 +5,9 @@
 // silent or delivers only garbage, reopens a serial device that went away, and prints its counters
 // periodically and at exit.
 //
+// Config: toposlam-bridge.yaml, by default $CONFIGURATION_DIRECTORY/toposlam-bridge.yaml, then the install's
+// <sysconfdir>/toposlam/toposlam-bridge.yaml, then /etc/toposlam/ (as toposlamd finds toposlam.yaml), else
+// the built-in defaults; options override it. --check-config and --print-config as toposlamd's.
 // Also: --emulate (an emulated controller on a new pseudo-terminal) and --bench (decoder throughput).
 // Exit status, as in toposlam and toposlamd: 0 done (signal or --duration), 1 runtime error (the link or
 // LCM cannot be opened: a restart may help), 2 usage or config error (bad options or config; CLI11's own
@@ -16,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -27,6 +31,9 @@
 
 #include "bench.hpp"
 #include "bridge_config.hpp"
+#include "config_key_cli.hpp"
+#include "toposlam/config/config_path.hpp"
+#include "toposlam/config/config_reader.hpp"
 #include "toposlam/firmware/emulator.hpp"
 #include "toposlam/firmware/motion_link.hpp"
 #include "toposlam/firmware/serial_port.hpp"
@@ -43,15 +50,15 @@ std::atomic<bool> g_stop{false};
 void onSignal(int) { g_stop = true; }
 
 std::unique_ptr<ByteStream> openLink(const bridge::BridgeConfig& c) {
-  if (c.udp_port != 0) return openUdp(c.udp_address, c.udp_port);
-  return openSerial(c.serial, c.baud);
+  if (c.link.udp_port != 0) return openUdp(c.link.udp_address, c.link.udp_port);
+  return openSerial(c.link.serial, c.link.baud);
 }
 
 const char* stateAdvice(LinkState s, const bridge::BridgeConfig& c) {
   switch (s) {
     case LinkState::Silent: return "no bytes: is the controller powered and its TX wired to our RX?";
     case LinkState::Garbage:
-      return c.udp_port != 0 ? "datagrams but no valid MAVLink 2 frame: is the router sending MAVLink 2?"
+      return c.link.udp_port != 0 ? "datagrams but no valid MAVLink 2 frame: is the router sending MAVLink 2?"
                              : "bytes but no valid frame: wrong baud rate or wrong --protocol?";
     default: return "";
   }
@@ -67,22 +74,22 @@ int runBridge(const bridge::BridgeConfig& c, double duration_s) {
   }
   std::unique_ptr<lcm::LCM> lcm;
   try {
-    lcm = openLcm(c.lcm_url);
+    lcm = openLcm(c.lcm.url);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;
   }
-  const LinkProtocol protocol = *parseProtocol(c.protocol);
-  spdlog::info("bridge: {} ({}) -> LCM {} on {}", stream->describe(), protocolName(protocol), c.channel, c.lcm_url);
+  const LinkProtocol protocol = c.link.protocol;
+  spdlog::info("bridge: {} ({}) -> LCM {} on {}", stream->describe(), protocolName(protocol), c.lcm.channel, c.lcm.url);
 
   MotionLink link(protocol, c.motion);
   const std::int64_t start_us = monotonicMicroseconds();
-  LinkMonitor monitor(start_us, c.link_timeout_s);
+  LinkMonitor monitor(start_us, c.status.link_timeout_s);
   LinkState reported = LinkState::Waiting;
   std::int64_t sequence = 0;
   std::int64_t publish_failures = 0;
   std::int64_t reopens = 0;
-  std::int64_t next_status_us = start_us + static_cast<std::int64_t>(c.status_period_s * 1e6);
+  std::int64_t next_status_us = start_us + static_cast<std::int64_t>(c.status.period_s * 1e6);
   std::int64_t next_reopen_us = 0;
   std::vector<std::uint8_t> encoded(256);
   std::uint8_t buffer[4096];
@@ -100,8 +107,8 @@ int runBridge(const bridge::BridgeConfig& c, double duration_s) {
     const int size = m.getEncodedSize();
     if (encoded.size() < static_cast<std::size_t>(size)) encoded.resize(static_cast<std::size_t>(size));
     m.encode(encoded.data(), 0, size);
-    if (lcm->publish(c.channel, encoded.data(), static_cast<unsigned>(size)) != 0 && publish_failures++ % 100 == 0)
-      spdlog::warn("bridge: publishing on {} failed ({} so far)", c.channel, publish_failures);
+    if (lcm->publish(c.lcm.channel, encoded.data(), static_cast<unsigned>(size)) != 0 && publish_failures++ % 100 == 0)
+      spdlog::warn("bridge: publishing on {} failed ({} so far)", c.lcm.channel, publish_failures);
   };
   auto status = [&](const char* when) {
     spdlog::info("bridge {}: link {}, published {}, publish failures {}, reopens {}; {}", when,
@@ -150,12 +157,12 @@ int runBridge(const bridge::BridgeConfig& c, double duration_s) {
       if (state == LinkState::Ok)
         spdlog::info("bridge: link ok ({} frames so far)", link.decoder().frames);
       else if (state != LinkState::Waiting)
-        spdlog::warn("bridge: link {} for {} s: {}", linkStateName(state), c.link_timeout_s, stateAdvice(state, c));
+        spdlog::warn("bridge: link {} for {} s: {}", linkStateName(state), c.status.link_timeout_s, stateAdvice(state, c));
       reported = state;
     }
-    if (c.status_period_s > 0 && t >= next_status_us) {
+    if (c.status.period_s > 0 && t >= next_status_us) {
       status("status");
-      next_status_us = t + static_cast<std::int64_t>(c.status_period_s * 1e6);
+      next_status_us = t + static_cast<std::int64_t>(c.status.period_s * 1e6);
     }
   }
   status("exit");
@@ -249,23 +256,28 @@ int runEmulator(const EmulateOptions& o) {
 int main(int argc, char** argv) {
   CLI::App app{"toposlam-bridge: robot controller link (wheel link or MAVLink 2) -> TOPOSLAM_MOTION over LCM"};
   app.set_version_flag("--version", "toposlam-bridge " TOPOSLAM_VERSION);  // project(VERSION), the package version
-  bridge::BridgeConfig config;
   std::string config_path;
-  std::string serial, protocol, lcm_url, channel;
-  int baud = 0, udp_port = -1;
-  double status_period = -1, duration = 0, bench_seconds = 1.0;
-  bool bench = false, help_config = false;
+  double duration = 0, bench_seconds = 1.0;
+  bool bench = false, help_config = false, check_only = false, print_config = false, shipped_config = false;
   std::string log_level = "info";
   EmulateOptions emulate;
   std::string emulate_kind;
-  app.add_option("-c,--config", config_path, "YAML config (keys: --help-config)");
-  app.add_option("--serial", serial, "serial device of the controller, e.g. /dev/ttyACM0");
-  app.add_option("--baud", baud, "baud rate (default 115200)");
-  app.add_option("--udp", udp_port, "listen for MAVLink on this UDP port of 127.0.0.1 (a router's output)");
-  app.add_option("--protocol", protocol, "wheel | mavlink (default wheel)");
-  app.add_option("--lcm-url", lcm_url, "LCM URL");
-  app.add_option("--channel", channel, "motion channel (default TOPOSLAM_MOTION)");
-  app.add_option("--status-period", status_period, "seconds between status lines, 0 = only at exit");
+  app.add_option("-c,--config", config_path,
+                 "config file (YAML; keys: --help-config). Default: " +
+                     toposlam::defaultConfigPath("toposlam-bridge.yaml") + " if it exists, else built-in defaults");
+  // The options that set a key come from the key table (bridge_config.cpp), as toposlamd's do.
+  const cli::ConfigKeyOptions<bridge::BridgeConfig> key_options(app, bridge::bridgeConfigKeys());
+  std::vector<std::string> sets;
+  app.add_option("--set", sets,
+                 "set any key of the config: --set KEY=VALUE (repeatable; keys and values as in the YAML, "
+                 "--help-config), applied after the file and the options above")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  app.add_flag("--check-config", check_only, "validate the config, print the result and exit");
+  app.add_flag("--print-config", print_config,
+               "print the effective config (file, defaults and options) as YAML with every key, and exit");
+  app.add_flag("--shipped-config", shipped_config,
+               "print the shipped toposlam-bridge.yaml (the defaults, every key with its help) and exit");
   app.add_option("--duration", duration, "stop after this many seconds (0 = until SIGINT/SIGTERM)");
   app.add_flag("--help-config", help_config, "list the config keys");
   app.add_option("--log-level", log_level, "log level: trace, debug, info, warn or error (default info)")
@@ -299,8 +311,13 @@ int main(int argc, char** argv) {
   signal(SIGTERM, onSignal);
   signal(SIGPIPE, SIG_IGN);
   if (help_config) {
-    std::printf("toposlam-bridge config keys (YAML sections link, lcm, status, motion):\n%s",
-                bridge::describeBridgeKeys().c_str());
+    std::printf("toposlam-bridge config keys (YAML sections link, lcm, status, motion):\n");
+    for (const bridge::BridgeConfigKey& key : bridge::bridgeConfigKeys())
+      std::printf("  %s (%s): %s\n", key.path.c_str(), key.rangeText().c_str(), key.help.c_str());
+    return 0;
+  }
+  if (shipped_config) {
+    std::printf("%s", bridge::shippedBridgeConfigYaml().c_str());
     return 0;
   }
   if (bench) return bridge::runBenchmark(bench_seconds);
@@ -308,17 +325,33 @@ int main(int argc, char** argv) {
     emulate.messages = emulate_kind;
     return runEmulator(emulate);
   }
+  bridge::BridgeConfig config;
   try {
-    if (!config_path.empty()) bridge::loadBridgeConfig(config_path, config);
-    if (!serial.empty()) config.serial = serial;
-    if (baud != 0) config.baud = baud;
-    if (udp_port >= 0) config.udp_port = udp_port;
-    if (!protocol.empty()) config.protocol = protocol;
-    if (!lcm_url.empty()) config.lcm_url = lcm_url;
-    if (!channel.empty()) config.channel = channel;
-    if (status_period >= 0) config.status_period_s = status_period;
-    if (config.udp_port != 0 && serial.empty()) config.serial.clear();
-    bridge::validateBridgeConfig(config);
+    const bool explicit_config = !config_path.empty();
+    if (!explicit_config) config_path = toposlam::defaultConfigPath("toposlam-bridge.yaml");
+    const bool read_file = explicit_config || std::filesystem::exists(config_path);
+    std::vector<ConfigOverride> given;
+    // --udp alone replaces the file's serial device: a UDP link has none.
+    if (key_options.given("link.udp_port") && !key_options.given("link.serial"))
+      given.push_back({"link.serial", "", "--udp"});
+    for (const ConfigOverride& o : key_options.overrides()) given.push_back(o);
+    for (const std::string& set : sets)
+      given.push_back(parseSetAssignment(configKeySpecs(bridge::bridgeConfigKeys()), set, "link.baud=57600",
+                                         "toposlam-bridge --help-config"));
+    config = bridge::bridgeCommandLineConfig(read_file ? config_path : std::string(), given);
+    if (!read_file) config_path = "(built-in defaults)";
+    if (print_config) {
+      std::printf("# toposlam-bridge's effective config: %s%s\n%s", config_path.c_str(),
+                  given.empty() ? "" : " and the options", bridge::bridgeConfigYaml(config, false).c_str());
+      return 0;
+    }
+    if (const std::string problem = bridge::linkProblem(config); !problem.empty())
+      throw ConfigError(config_path + ": " + problem);
+    if (check_only) {
+      std::printf("toposlam-bridge: config OK: %s\n", config_path.c_str());
+      return 0;
+    }
+    spdlog::info("toposlam-bridge: config {}", config_path);
   } catch (const std::exception& e) {
     spdlog::error("toposlam-bridge: {}", e.what());
     return 2;

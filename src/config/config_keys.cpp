@@ -3,12 +3,9 @@
 // plus the "default" method preset); test_config_keys checks every one mechanically.
 #include "toposlam/config/config_keys.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
-#include <type_traits>
 #include <utility>
 
 #include "toposlam/config/daemon_config.hpp"
@@ -21,104 +18,20 @@ namespace {
 // The member a key lands in, for const and non-const configs alike.
 #define AT(member) [](auto& c) -> auto& { return c.member; }
 
-// Range ends in messages and docs: the stream's default format ("0.1", "1e+06").
-std::string rangeNumber(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
+// Range ends in cross-check messages.
+std::string rangeNumber(double v) { return configRangeNumber(v); }
 
-ConfigKey base(std::string path, ConfigKind kind, std::string unit, std::string help) {
-  ConfigKey k;
-  k.path = std::move(path);
-  k.kind = kind;
-  k.unit = std::move(unit);
-  k.help = std::move(help);
-  return k;
-}
-
-template <typename Access>
-ConfigKey integer(std::string path, Access access, long long def, long long lo, long long hi, std::string unit,
-                  std::string help) {
-  ConfigKey k = base(std::move(path), ConfigKind::Integer, std::move(unit), std::move(help));
-  k.default_value = def;
-  k.integer_low = lo;
-  k.integer_high = hi;
-  k.low = static_cast<double>(lo);
-  k.high = static_cast<double>(hi);
-  k.get = [access](const DaemonConfig& c) -> ConfigValue { return static_cast<long long>(access(c)); };
-  k.set = [access](DaemonConfig& c, const ConfigValue& v) {
-    auto& member = access(c);
-    member = static_cast<std::remove_reference_t<decltype(member)>>(std::get<long long>(v));
-  };
-  return k;
-}
-
-template <typename Access>
-ConfigKey real(std::string path, Access access, double def, double lo, double hi, std::string unit, std::string help) {
-  ConfigKey k = base(std::move(path), ConfigKind::Real, std::move(unit), std::move(help));
-  k.default_value = def;
-  k.low = lo;
-  k.high = hi;
-  k.get = [access](const DaemonConfig& c) -> ConfigValue { return static_cast<double>(access(c)); };
-  k.set = [access](DaemonConfig& c, const ConfigValue& v) { access(c) = std::get<double>(v); };
-  return k;
-}
-
-template <typename Access>
-ConfigKey flag(std::string path, Access access, bool def, std::string help) {
-  ConfigKey k = base(std::move(path), ConfigKind::Flag, "", std::move(help));
-  k.default_value = def;
-  k.get = [access](const DaemonConfig& c) -> ConfigValue { return static_cast<bool>(access(c)); };
-  k.set = [access](DaemonConfig& c, const ConfigValue& v) { access(c) = std::get<bool>(v); };
-  return k;
-}
-
-/// A string of min_length .. max_length characters.
-template <typename Access>
-ConfigKey text(std::string path, Access access, std::string def, std::size_t min_length, std::size_t max_length,
-               std::string help) {
-  ConfigKey k = base(std::move(path), ConfigKind::Text, "", std::move(help));
-  k.default_value = std::move(def);
-  k.min_length = min_length;
-  k.max_length = max_length;
-  k.get = [access](const DaemonConfig& c) -> ConfigValue { return std::string(access(c)); };
-  k.set = [access](DaemonConfig& c, const ConfigValue& v) { access(c) = std::get<std::string>(v); };
-  return k;
-}
-
-/// One of `names`, each naming a value of the member (an enum or a string).
-template <typename Access, typename Value>
-ConfigKey choice(std::string path, Access access, Value def, std::vector<std::pair<std::string, Value>> names,
-                 std::string help) {
-  ConfigKey k = base(std::move(path), ConfigKind::Choice, "", std::move(help));
-  for (const auto& [name, value] : names) {
-    k.choices.push_back(name);
-    if (value == def) k.default_value = name;
-  }
-  k.get = [access, names](const DaemonConfig& c) -> ConfigValue {
-    for (const auto& [name, value] : names)
-      if (value == access(c)) return name;
-    return std::string("?");  // a value outside the table: problem() refuses it
-  };
-  k.set = [access, names](DaemonConfig& c, const ConfigValue& v) {
-    for (const auto& [name, value] : names)
-      if (name == std::get<std::string>(v)) access(c) = value;
-  };
-  return k;
-}
-
-template <typename Access>
-ConfigKey choice(std::string path, Access access, const std::string& def, const std::vector<std::string>& names,
-                 std::string help) {
-  std::vector<std::pair<std::string, std::string>> pairs;
-  for (const std::string& n : names) pairs.emplace_back(n, n);
-  return choice(std::move(path), access, def, pairs, std::move(help));
-}
+// The table is built by static members of a ConfigKeyBuilders<DaemonConfig>, so integer(...), real(...) ... name
+// the builders of config_key.hpp.
+struct DaemonKeyTable : ConfigKeyBuilders<DaemonConfig> {
+  static void addThread(std::vector<ConfigKey>& keys, const std::string& thread, ThreadSettings PipelineThreads::*member,
+                        const std::string& def_name, int def_nice = 0);
+  static std::vector<ConfigKey> makeKeys();
+};
 
 // The five keys of one pipeline thread.
-void addThread(std::vector<ConfigKey>& keys, const std::string& thread, ThreadSettings PipelineThreads::*member,
-               const std::string& def_name, int def_nice = 0) {
+void DaemonKeyTable::addThread(std::vector<ConfigKey>& keys, const std::string& thread,
+                               ThreadSettings PipelineThreads::*member, const std::string& def_name, int def_nice) {
   const std::string p = "pipeline.threads." + thread + ".";
   const auto at = [member](auto& c) -> auto& { return c.pipeline.threads.*member; };
   keys.push_back(text(p + "name", [at](auto& c) -> auto& { return at(c).name; }, def_name, 1, 15,
@@ -144,7 +57,7 @@ void addThread(std::vector<ConfigKey>& keys, const std::string& thread, ThreadSe
                          "nice value with policy other (0 = leave as is)"));
 }
 
-std::vector<ConfigKey> makeKeys() {
+std::vector<ConfigKey> DaemonKeyTable::makeKeys() {
   const long long kMaxSeed = std::numeric_limits<long long>::max();
   std::vector<ConfigKey> k;
   // Top level.
@@ -602,102 +515,9 @@ void markMapSettings(std::vector<ConfigKey>& keys) {
 
 }  // namespace
 
-std::string ConfigKey::rangeText() const {
-  std::string range;
-  switch (kind) {
-    case ConfigKind::Integer:
-      range = std::to_string(integer_low) + " .. " + std::to_string(integer_high);
-      break;
-    case ConfigKind::Real:
-      range = std::string(low_open ? "(" : "[") + rangeNumber(low) + ", " + rangeNumber(high) + (high_open ? ")" : "]");
-      break;
-    case ConfigKind::Flag:
-      range = "true or false";
-      break;
-    case ConfigKind::Text:
-      range = std::to_string(min_length) + " to " + std::to_string(max_length) + " characters";
-      break;
-    case ConfigKind::Choice:
-      for (const std::string& c : choices) range += (range.empty() ? "one of: " : ", ") + c;
-      break;
-  }
-  if (!unit.empty()) range += " " + unit;
-  if (!note.empty()) range += " (" + note + ")";
-  return range;
-}
-
-std::string ConfigKey::problem(const ConfigValue& value) const {
-  switch (kind) {
-    case ConfigKind::Integer: {
-      const long long v = std::get<long long>(value);
-      if (v >= integer_low && v <= integer_high) return "";
-      return std::to_string(v) + " is out of range, allowed " + rangeText();
-    }
-    case ConfigKind::Real: {
-      const double v = std::get<double>(value);
-      const bool inside =
-          std::isfinite(v) && (low_open ? v > low : v >= low) && (high_open ? v < high : v <= high);
-      if (inside) return "";
-      return rangeNumber(v) + " is out of range, allowed " + rangeText();
-    }
-    case ConfigKind::Flag:
-      return "";
-    case ConfigKind::Text: {
-      const std::string& v = std::get<std::string>(value);
-      if (v.size() >= min_length && v.size() <= max_length) return "";
-      if (v.empty() && !example.empty()) return "must not be empty (e.g. " + example + ")";
-      return "must have " + std::to_string(min_length) + " to " + std::to_string(max_length) + " characters, got '" +
-             v + "'";
-    }
-    case ConfigKind::Choice: {
-      const std::string& v = std::get<std::string>(value);
-      for (const std::string& c : choices)
-        if (c == v) return "";
-      std::string list;
-      for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
-      return "'" + v + "' is not allowed, expected one of: " + list;
-    }
-  }
-  return "";
-}
-
-std::string ConfigKey::yamlText(const ConfigValue& value) const {
-  switch (kind) {
-    case ConfigKind::Integer:
-      return std::to_string(std::get<long long>(value));
-    case ConfigKind::Real: {
-      char buffer[64];
-      const auto result = std::to_chars(buffer, buffer + sizeof buffer, std::get<double>(value));
-      std::string text(buffer, result.ptr);
-      // A real reads as a real: "5" would too, but "5.0" says what the key is; "1e+06" reads back exactly.
-      if (text.find_first_of(".en") == std::string::npos) text += ".0";
-      return text;
-    }
-    case ConfigKind::Flag:
-      return std::get<bool>(value) ? "true" : "false";
-    case ConfigKind::Choice:
-      return std::get<std::string>(value);
-    case ConfigKind::Text: {
-      std::string quoted = "\"";
-      for (const char ch : std::get<std::string>(value)) {
-        if (ch == '"' || ch == '\\') quoted += '\\';
-        quoted += ch;
-      }
-      return quoted + "\"";
-    }
-  }
-  return "";
-}
-
-double ConfigKey::defaultNumber() const {
-  if (kind == ConfigKind::Integer) return static_cast<double>(std::get<long long>(default_value));
-  if (kind == ConfigKind::Real) return std::get<double>(default_value);
-  throw std::logic_error("config key " + path + " is not a number");
-}
-
 const std::vector<ConfigKey>& daemonConfigKeys() {
   static const std::vector<ConfigKey> keys = [] {
-    std::vector<ConfigKey> k = makeKeys();
+    std::vector<ConfigKey> k = DaemonKeyTable::makeKeys();
     markMapSettings(k);
     return k;
   }();

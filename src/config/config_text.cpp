@@ -1,43 +1,21 @@
 // Texts made from the config key table: see config_text.hpp.
 #include "toposlam/config/config_text.hpp"
 
-#include <set>
-#include <sstream>
+#include <functional>
 #include <vector>
 
 #include "toposlam/config/config_keys.hpp"
+#include "toposlam/config/config_reader.hpp"
 #include "toposlam/config/daemon_config.hpp"
 
 namespace toposlam {
 
 namespace {
 
-constexpr std::size_t kLineWidth = 110;
-
-// `text` as comment lines starting with `prefix` ("  # "), broken between words before kLineWidth.
-std::string commentLines(const std::string& prefix, const std::string& text) {
-  std::string out, line = prefix;
-  std::istringstream words(text);
-  for (std::string word; words >> word;) {
-    if (line.size() > prefix.size() && line.size() + 1 + word.size() > kLineWidth) {
-      out += line + "\n";
-      line = prefix;
-    }
-    line += (line.size() > prefix.size() ? " " : "") + word;
-  }
-  return out + line + "\n";
-}
-
 std::string sectionHelp(const std::string& path) {
   for (const ConfigSection& s : daemonConfigSections())
     if (s.path == path) return s.help;
   return "";
-}
-
-// The section part of a key path ("a.b" of "a.b.c"; "" at the top level).
-std::string sectionOf(const std::string& path) {
-  const std::size_t dot = path.rfind('.');
-  return dot == std::string::npos ? "" : path.substr(0, dot);
 }
 
 std::vector<std::string> split(const std::string& path) {
@@ -57,8 +35,7 @@ DaemonConfig thesisConfig() {
 
 // A key's comment: its help, its allowed values and the thesis preset's value where it differs.
 std::string keyComment(const ConfigKey& key, const DaemonConfig& thesis) {
-  std::string comment = key.help;
-  if (key.kind != ConfigKind::Flag) comment += "; allowed " + key.rangeText();
+  std::string comment = configKeyComment(key);
   const ConfigValue thesis_value = key.get(thesis);
   if (key.path != "preset" && thesis_value != key.default_value)
     comment += "; thesis preset " + key.yamlText(thesis_value);
@@ -69,36 +46,11 @@ std::string keyComment(const ConfigKey& key, const DaemonConfig& thesis) {
 
 std::string configYaml(const DaemonConfig& config, bool comments) {
   const DaemonConfig thesis = thesisConfig();
-  std::string out;
-  std::vector<std::string> open;  // the sections the previous key was in
-  std::set<std::string> explained;
-  for (const ConfigKey& key : daemonConfigKeys()) {
-    const std::vector<std::string> sections = split(sectionOf(key.path));
-    std::size_t common = 0;
-    while (common < open.size() && common < sections.size() && open[common] == sections[common]) ++common;
-    open.resize(common);
-    for (std::size_t depth = common; depth < sections.size(); ++depth) {
-      const std::string indent(2 * depth, ' ');
-      open.push_back(sections[depth]);
-      std::string path;
-      for (const std::string& s : open) path += (path.empty() ? "" : ".") + s;
-      if (depth == 0) out += "\n";
-      if (comments && !sectionHelp(path).empty()) out += commentLines(indent + "# ", sectionHelp(path));
-      out += indent + sections[depth] + ":\n";
-    }
-    const std::string indent(2 * sections.size(), ' ');
-    if (comments) {
-      if (sections.empty()) out += "\n";
-      // The threads' five keys are explained once, at the first thread.
-      const std::string comment = keyComment(key, thesis);
-      const std::string grandparent = sectionOf(sectionOf(key.path));
-      if (explained.insert(grandparent + "|" + split(key.path).back() + "|" + comment).second)
-        out += commentLines(indent + "# ", comment);
-    }
-    const std::vector<std::string> parts = split(key.path);
-    out += indent + parts.back() + ": " + key.yamlText(key.get(config)) + "\n";
-  }
-  return out;
+  const std::vector<ConfigKey>& keys = daemonConfigKeys();
+  std::function<std::string(std::size_t)> comment;
+  if (comments) comment = [&](std::size_t i) { return keyComment(keys[i], thesis); };
+  return configYamlText(
+      configKeySpecs(keys), [&](std::size_t i) { return keys[i].yamlText(keys[i].get(config)); }, comment, sectionHelp);
 }
 
 std::string shippedConfigYaml() {

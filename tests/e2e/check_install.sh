@@ -1,5 +1,5 @@
 #!/bin/sh
-# `cmake --install` puts the service binary, the unit, the default config and the LCM definitions in place,
+# `cmake --install` puts the service binaries, their units, the default configs and the LCM definitions in place,
 # at the FHS paths a package uses: with --prefix /usr the config is /etc/toposlam/toposlam.yaml (where
 # toposlamd and the unit's ConfigurationDirectory= look), never /usr/etc. Another prefix keeps it under
 # the prefix (P/etc/toposlam).
@@ -12,6 +12,7 @@ fail() { echo "$*"; exit 1; }
 # 1. A package's install: DESTDIR staging, prefix /usr.
 DESTDIR="$dest/pkg" cmake --install "$build" --prefix /usr >/dev/null
 for f in usr/sbin/toposlamd usr/bin/toposlam usr/lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
+         usr/bin/toposlam-bridge usr/lib/systemd/system/toposlam-bridge.service \
          usr/share/toposlam/lcm/place_t.lcm usr/share/toposlam/lcm/motion_t.lcm usr/include/toposlam_lcm/place_t.hpp \
          usr/share/doc/toposlam/examples/50-toposlam-multicast.network etc/toposlam/toposlam-bridge.yaml \
          usr/lib/python3/dist-packages/toposlam_lcm/__init__.py usr/lib/python3/dist-packages/toposlam_lcm/udpm_reader.py \
@@ -26,6 +27,10 @@ grep -q "^ExecStart=/usr/sbin/toposlamd\$" "$dest/pkg/usr/lib/systemd/system/top
 grep -q "^Documentation=file:///usr/share/doc/toposlam/daemon.md\$" "$dest/pkg/usr/lib/systemd/system/toposlamd.service" \
   || fail "the unit installed with --prefix /usr does not name /usr/share/doc/toposlam/daemon.md"
 "$dest/pkg/usr/sbin/toposlamd" --check-config -c "$dest/pkg/etc/toposlam/toposlam.yaml"
+grep -q "^ExecStart=/usr/bin/toposlam-bridge\$" "$dest/pkg/usr/lib/systemd/system/toposlam-bridge.service" \
+  || fail "the bridge unit installed with --prefix /usr does not start /usr/bin/toposlam-bridge"
+grep -q "^Documentation=file:///usr/share/doc/toposlam/firmware-host.md\$" "$dest/pkg/usr/lib/systemd/system/toposlam-bridge.service" \
+  || fail "the bridge unit installed with --prefix /usr does not name /usr/share/doc/toposlam/firmware-host.md"
 # The video module (loaded on first use) is installed beside the programs, and the installed program
 # loads that copy, not the build tree's.
 module=$(find "$dest/pkg/usr/lib" -name toposlam-source-video.so)
@@ -76,10 +81,20 @@ fi
 # 2. A private prefix: everything under it, the unit pointing at its binary.
 cmake --install "$build" --prefix "$dest/local" >/dev/null
 for f in sbin/toposlamd bin/toposlam lib/systemd/system/toposlamd.service etc/toposlam/toposlam.yaml \
+         bin/toposlam-bridge lib/systemd/system/toposlam-bridge.service etc/toposlam/toposlam-bridge.yaml \
          lib/python3/dist-packages/toposlam_lcm/place_t.py share/toposlam/view/live_view.py; do
   [ -e "$dest/local/$f" ] || fail "missing after install --prefix P: P/$f"
 done
 grep -q "^ExecStart=$dest/local/sbin/toposlamd\$" "$dest/local/lib/systemd/system/toposlamd.service" \
   || fail "the installed unit does not start the installed binary"
 "$dest/local/sbin/toposlamd" --check-config -c "$dest/local/etc/toposlam/toposlam.yaml"
+grep -q "^ExecStart=$dest/local/bin/toposlam-bridge\$" "$dest/local/lib/systemd/system/toposlam-bridge.service" \
+  || fail "the installed bridge unit does not start the installed binary"
+# Without -c, the installed programs read the configs of their own prefix (not the configure-time one).
+(unset CONFIGURATION_DIRECTORY; "$dest/local/sbin/toposlamd" --print-config) | head -n 1 \
+  | grep -qx "# toposlamd's effective config: $dest/local/etc/toposlam/toposlam.yaml" \
+  || fail "the installed toposlamd does not read P/etc/toposlam/toposlam.yaml by default"
+(unset CONFIGURATION_DIRECTORY; "$dest/local/bin/toposlam-bridge" --print-config) | head -n 1 \
+  | grep -qx "# toposlam-bridge's effective config: $dest/local/etc/toposlam/toposlam-bridge.yaml" \
+  || fail "the installed toposlam-bridge does not read P/etc/toposlam/toposlam-bridge.yaml by default"
 echo "install OK"

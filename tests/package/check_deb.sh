@@ -27,6 +27,7 @@ diff "$tmp/installed" "$tmp/files" >"$tmp/files.diff" \
   || { cat "$tmp/files.diff"; fail "the package's files differ from cmake --install --prefix /usr (< install, > package)"; }
 for f in /usr/bin/toposlam /usr/sbin/toposlamd /usr/bin/toposlam-bridge /usr/bin/toposlam-bench \
          /usr/share/man/man1/toposlam-bench.1.gz /usr/lib/systemd/system/toposlamd.service \
+         /usr/lib/systemd/system/toposlam-bridge.service \
          /etc/toposlam/toposlam.yaml /etc/toposlam/toposlam-bridge.yaml /usr/share/toposlam/lcm/place_t.lcm \
          /usr/include/toposlam_lcm/place_t.hpp /usr/share/pkgconfig/toposlam-lcm.pc /usr/share/doc/toposlam/copyright \
          /usr/share/doc/toposlam/changelog.gz /usr/share/man/man1/toposlam.1.gz /usr/share/man/man8/toposlamd.8.gz \
@@ -69,6 +70,25 @@ echo "$out" | grep -q "config OK" || fail "toposlamd --check-config said: $out"
   || fail "toposlam-bench --version"
 grep -qx "ExecStart=/usr/sbin/toposlamd" "$tmp/root/usr/lib/systemd/system/toposlamd.service" \
   || fail "the packaged unit does not start /usr/sbin/toposlamd"
+grep -qx "ExecStart=/usr/bin/toposlam-bridge" "$tmp/root/usr/lib/systemd/system/toposlam-bridge.service" \
+  || fail "the packaged bridge unit does not start /usr/bin/toposlam-bridge"
+# The shipped bridge config is valid but names no link yet: --check-config says so (exit 2); with one, OK.
+rc=0
+out="$("$tmp/root/usr/bin/toposlam-bridge" --check-config -c "$tmp/root/etc/toposlam/toposlam-bridge.yaml" 2>&1)" || rc=$?
+[ $rc -eq 2 ] && echo "$out" | grep -q "no link" || fail "toposlam-bridge --check-config on the shipped config: $out"
+out="$("$tmp/root/usr/bin/toposlam-bridge" --check-config -c "$tmp/root/etc/toposlam/toposlam-bridge.yaml" \
+         --serial /dev/ttyACM0 2>&1)" || fail "toposlam-bridge --check-config --serial on the shipped config: $out"
+# Both units as packaged: systemd-analyze verify, with the extracted programs in place of /usr's.
+if command -v systemd-analyze >/dev/null; then
+  for unit in toposlamd toposlam-bridge; do
+    sed "s|^ExecStart=/usr/|ExecStart=$tmp/root/usr/|" "$tmp/root/usr/lib/systemd/system/$unit.service" >"$tmp/$unit.service"
+    out="$(systemd-analyze verify "$tmp/$unit.service" 2>&1)" && [ -z "$out" ] \
+      || fail "systemd-analyze verify of the packaged $unit.service: $out"
+  done
+  echo "units: systemd-analyze verify accepts toposlamd.service and toposlam-bridge.service"
+else
+  echo "units: not verified (systemd-analyze not installed; apt-get install systemd)"
+fi
 # The message headers compile with the flags of the packaged pkg-config file.
 cflags="$(PKG_CONFIG_PATH="$tmp/root/usr/share/pkgconfig" pkg-config --cflags toposlam-lcm)" \
   || fail "pkg-config toposlam-lcm"

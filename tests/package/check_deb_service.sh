@@ -5,7 +5,8 @@
 # upper layer; the host is not changed) and has its own network with only loopback, given the multicast
 # route. In it: `dpkg -i` (the conffile /etc/toposlam/toposlam.yaml in place), the config pointed at a folder
 # of images (no camera), `systemctl start toposlamd` (Type=notify: returns once READY=1), its status, place
-# messages read with `toposlam listen`, `systemctl stop` (the final map saved, exit 0).
+# messages read with `toposlam listen`, `systemctl stop` (the final map saved, exit 0); then the bridge's
+# unit, given a UDP link, started and stopped.
 # Usage: check_deb_service.sh CPACK BUILD_DIR VERSION FRAMES_DIR   (TOPOSLAM_DEB=FILE: that package instead)
 # Exit 77 (skipped) without root, systemd-nspawn, systemd, overlayfs or dpkg-deb, or when the container does
 # not boot (an environment that cannot run one: the boot log is printed).
@@ -34,7 +35,8 @@ cleanup() {
 trap cleanup EXIT
 fail() {
   echo "FAIL: $*"
-  [ -z "$leader" ] || in_container journalctl --no-pager -u toposlamd.service 2>/dev/null | tail -40 || true
+  [ -z "$leader" ] || in_container journalctl --no-pager -u toposlamd.service -u toposlam-bridge.service 2>/dev/null \
+    | tail -40 || true
   exit 1
 }
 leader=""
@@ -128,4 +130,36 @@ in_container test -s /var/lib/private/toposlam/map.tsm || fail "no /var/lib/priv
 in_container journalctl --no-pager -u toposlamd.service -o cat >"$tmp/journal.log"
 grep -q "map saved\|saved the map\|map saves" "$tmp/journal.log" || { cat "$tmp/journal.log"; fail "no map save in the journal"; }
 echo "stopped: exit 0, $(in_container stat -c %s /var/lib/private/toposlam/map.tsm)-byte map; journal: $(grep -m 1 "frames published" "$tmp/journal.log" || true)"
+
+# 6. toposlam-bridge's unit: installed, not enabled, its conffile registered; the config given a link as a
+#    user would (MAVLink from a router on UDP port 14550: no serial device in a container), read by default
+#    (--check-config without -c), the unit started (Type=exec), its loop running (the link reported silent:
+#    no router sends), stopped (exit 0, the exit counters in the journal).
+[ "$(in_container systemctl is-enabled toposlam-bridge.service 2>&1 || true)" = disabled ] \
+  || fail "toposlam-bridge.service should be installed but not enabled: $(in_container systemctl is-enabled toposlam-bridge.service 2>&1)"
+in_container dpkg-query -W -f='${Conffiles}\n' toposlam | grep -q '^ /etc/toposlam/toposlam-bridge.yaml [0-9a-f]\{32\}' \
+  || fail "/etc/toposlam/toposlam-bridge.yaml is no conffile of the installed package"
+in_container sed -i 's|^  protocol: wheel$|  protocol: mavlink|; s|^  udp_port: 0$|  udp_port: 14550|' \
+  /etc/toposlam/toposlam-bridge.yaml
+in_container toposlam-bridge --check-config | grep -qx "toposlam-bridge: config OK: /etc/toposlam/toposlam-bridge.yaml" \
+  || fail "toposlam-bridge --check-config does not read /etc/toposlam/toposlam-bridge.yaml by default"
+in_container systemctl start toposlam-bridge.service || fail "systemctl start toposlam-bridge.service"
+bshow() { in_container systemctl show -p "$1" --value toposlam-bridge.service; }
+i=0
+while [ $i -lt 100 ] && ! in_container journalctl --no-pager -u toposlam-bridge.service -o cat | grep -q "link silent"; do
+  sleep 0.1; i=$((i + 1))
+done
+[ "$(bshow ActiveState)/$(bshow SubState)" = active/running ] \
+  || fail "toposlam-bridge after start: $(bshow ActiveState)/$(bshow SubState)"
+in_container journalctl --no-pager -u toposlam-bridge.service -o cat >"$tmp/bridge.log"
+grep -q "config /etc/toposlam/toposlam-bridge.yaml" "$tmp/bridge.log" || { cat "$tmp/bridge.log"; fail "the bridge unit read no config"; }
+grep -q "bridge: udp:127.0.0.1:14550 (mavlink) -> LCM TOPOSLAM_MOTION" "$tmp/bridge.log" || { cat "$tmp/bridge.log"; fail "the bridge unit opened no UDP link"; }
+grep -q "link silent" "$tmp/bridge.log" || { cat "$tmp/bridge.log"; fail "the bridge unit did not report the silent link"; }
+echo "bridge started: $(bshow ActiveState)/$(bshow SubState), main process $(bshow MainPID) ($(elapsed "$t0") s)"
+in_container systemctl stop toposlam-bridge.service
+[ "$(bshow Result)" = success ] || fail "toposlam-bridge: Result=$(bshow Result) after stop"
+[ "$(bshow ExecMainStatus)" = 0 ] || fail "toposlam-bridge: exit status $(bshow ExecMainStatus) after stop"
+in_container journalctl --no-pager -u toposlam-bridge.service -o cat | grep -q "bridge exit: " \
+  || fail "no exit line of the bridge in the journal"
+echo "bridge stopped: exit 0"
 echo "service OK ($(elapsed "$t0") s)"

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "toposlam/config/config_key.hpp"
+#include "toposlam/config/config_reader.hpp"
 #include "toposlam/fingerprint/vpack_extractor.hpp"
 #include "toposlam/matching/ngram_similarity.hpp"
 #include "toposlam/pipeline/algorithm_stages.hpp"
@@ -22,11 +24,6 @@
 
 namespace toposlam {
 
-/// A bad configuration: what() names the key (full dotted path) and the allowed values.
-class ConfigError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct LcmSettings {
   std::string url = "udpm://239.255.76.67:7667?ttl=0";  ///< ttl=0: multicast stays on this host
@@ -85,8 +82,6 @@ void applyMethodPreset(const std::string& name, DaemonConfig& config);
 /// text's other keys, as the text's own preset would be).
 DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& origin = "config",
                                const std::string& preset = "");
-/// A config file larger than this is refused (bytes).
-inline constexpr std::size_t kMaxConfigBytes = 1 << 20;
 /// Reads and parses a file; ConfigError if it cannot be read, is a folder or is over kMaxConfigBytes.
 /// A repeated key or a second YAML document is refused (parseDaemonConfig).
 DaemonConfig loadDaemonConfig(const std::string& path, const std::string& preset = "");
@@ -95,14 +90,6 @@ DaemonConfig loadDaemonConfig(const std::string& path, const std::string& preset
 /// ("map.save_period_s", "30"); ConfigError naming the key if the text is not a value of its kind.
 /// Ranges are checked by validate().
 void setConfigValue(DaemonConfig& config, const std::string& path, const std::string& text);
-
-/// One key set on a command line: the key's path, its value as text, and how the user wrote it for
-/// messages ("--set segmentation.window_s=6", "--window-s").
-struct ConfigOverride {
-  std::string path;
-  std::string text;
-  std::string given_as;
-};
 
 /// The override of `--set KEY=VALUE` (`assignment` is "KEY=VALUE"); ConfigError "command line: --set TEXT:
 /// ..." when it

@@ -19,6 +19,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -262,15 +263,20 @@ void runReport(ReportCommandOptions o) {
   } else {
     const std::vector<std::int64_t> frames = eval::framesForThumbnails(in.run, o.thumbnails);
     const std::vector<fs::path> paths = thumbnailPaths(in.run, frames, folders);
-    // A frame without a picture of its own (toposlamd's log carries one per place, its representative's)
-    // shows its place's picture; only a frame with neither is missing.
+    // Folders of one picture per place (toposlamd's log carries its representatives' only): a frame
+    // without a picture of its own shows its place's. Elsewhere a missing frame is reported, not replaced.
     std::map<std::int64_t, std::string> by_frame;
     for (std::size_t k = 0; k < frames.size(); ++k)
       if (!paths[k].empty()) by_frame[frames[k]] = thumbnailDataUri(paths[k]);
+    std::set<std::int64_t> representatives;
+    for (const PlaceRecord& p : in.run.places) representatives.insert(p.representative);
+    const bool per_place = !by_frame.empty() && std::all_of(by_frame.begin(), by_frame.end(), [&](const auto& e) {
+      return e.second.empty() || representatives.count(e.first) != 0;
+    });
     int missing = 0, from_place = 0;
     for (const std::int64_t f : frames) {
       std::string uri = by_frame.count(f) != 0 ? by_frame[f] : "";
-      if (uri.empty()) uri = placePicture(in.run, f, by_frame);
+      if (uri.empty() && per_place) uri = placePicture(in.run, f, by_frame);
       if (!uri.empty() && (by_frame.count(f) == 0 || by_frame[f].empty())) ++from_place;
       if (uri.empty()) ++missing;
       in.thumbnails[static_cast<std::size_t>(f)] = std::move(uri);

@@ -1,6 +1,7 @@
 // toposlamd: the real-time topological SLAM service. Reads one config (default
-// $CONFIGURATION_DIRECTORY/toposlam.yaml, then /etc/toposlam/toposlam.yaml, else built-in defaults),
-// runs the pipeline and publishes over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
+// $CONFIGURATION_DIRECTORY/toposlam.yaml, then the install's <sysconfdir>/toposlam/toposlam.yaml, then
+// /etc/toposlam/toposlam.yaml, else built-in defaults: config_path.hpp), runs the pipeline and publishes
+// over LCM. Thin: parses arguments, loads the config, runs daemon.cpp.
 #include <csignal>
 #include <exception>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "config_key_cli.hpp"
 #include "daemon.hpp"
 #include "sources.hpp"
 #include "toposlam/config/config_keys.hpp"
@@ -49,35 +51,8 @@ int main(int argc, char** argv) {
   bool check_only = false, print_config = false;
   app.add_option("-c,--config", config_path, "config file (YAML; see config/toposlam.yaml and docs/config.md). Default: " +
                                                  toposlam::defaultDaemonConfigPath() + " if it exists, else built-in defaults");
-  // The override options come from the key table (config_keys.cpp): one per key that names one. A flag
-  // sets its key to the table's value; any other option takes the key's value as on the YAML side.
-  struct Override {
-    const toposlam::ConfigKey* key;
-    CLI::Option* option;
-    std::string text;
-  };
-  std::vector<std::unique_ptr<Override>> overrides;
-  for (const toposlam::ConfigKey& key : toposlam::daemonConfigKeys()) {
-    if (key.option.empty()) continue;
-    auto o = std::make_unique<Override>(Override{&key, nullptr, {}});
-    if (key.kind == toposlam::ConfigKind::Flag || !key.option_value.empty()) {
-      o->text = !key.option_value.empty() ? key.option_value : key.option_sets ? "true" : "false";
-      const std::string help = "set `" + key.path + "` to " + o->text + " (" + key.help + ")";
-      o->option = app.add_flag(key.option, help);
-    } else {
-      o->option = app.add_option(key.option, o->text,
-                                 "override `" + key.path + "`: " + key.help + " (" + key.rangeText() + ")");
-      if (key.kind == toposlam::ConfigKind::Choice) o->option->check(CLI::IsMember(key.choices));
-      if (key.kind == toposlam::ConfigKind::Integer) o->option->type_name("INT");
-      if (key.kind == toposlam::ConfigKind::Real) o->option->type_name("NUMBER");
-    }
-    overrides.push_back(std::move(o));
-  }
-  const auto given = [&](const std::string& path) -> const Override* {
-    for (const auto& o : overrides)
-      if (o->key->path == path && o->option->count() > 0) return o.get();
-    return nullptr;
-  };
+  // The override options come from the key table (config_keys.cpp): one per key that names one.
+  const toposlam::cli::ConfigKeyOptions<toposlam::DaemonConfig> key_options(app, toposlam::daemonConfigKeys());
   std::vector<std::string> sets;
   app.add_option("--set", sets,
                  "set any key of the config: --set KEY=VALUE (repeatable; keys and values as in the YAML, "
@@ -95,17 +70,15 @@ int main(int argc, char** argv) {
   }
   // stderr, in the journal's format under systemd; the level of --log-level, else info until the config
   // has been read (its log.level then applies).
-  const Override* level_option = given("log_level");
+  const std::string* level_option = key_options.given("log_level");
   const bool journal = g_journal =
-      toposlam::configureLogging("toposlamd", *toposlam::parseLogLevel(level_option ? level_option->text : "info"));
+      toposlam::configureLogging("toposlamd", *toposlam::parseLogLevel(level_option ? *level_option : "info"));
 
   try {
     const bool explicit_config = !config_path.empty();
     if (!explicit_config) config_path = toposlam::defaultDaemonConfigPath();
     const bool read_file = explicit_config || std::filesystem::exists(config_path);
-    std::vector<toposlam::ConfigOverride> given_overrides;
-    for (const auto& o : overrides)
-      if (o->option->count() > 0) given_overrides.push_back({o->key->path, o->text, o->key->option});
+    std::vector<toposlam::ConfigOverride> given_overrides = key_options.overrides();
     for (const std::string& set : sets) given_overrides.push_back(toposlam::parseSetOverride(set));
     const bool options_given = !given_overrides.empty();
     const toposlam::DaemonConfig config =
