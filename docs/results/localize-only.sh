@@ -17,32 +17,7 @@ T="$build/src/apps/toposlam/toposlam"
 [ -x "$T" ] || { echo "localize-only: no $T (build first: scripts/build.sh)" >&2; exit 2; }
 mkdir -p "$work"
 data="$repo/tests/data"
-split_sim() {  # world: two laps split into $work/<world>/lap1 and lap2 (frames, timestamps, labels)
-  local world=$1
-  local dir="$work/$world"
-  [ -f "$dir/lap2/labels.csv" ] && return
-  "$T" sim "$world" --route loop2 --out "$dir/both" >/dev/null 2>&1
-  python3 - "$dir" <<'PY'
-import csv, os, shutil, sys
-d = sys.argv[1]
-labels = list(csv.DictReader(open(d + "/both/labels.csv")))
-times = {r["name"]: r["time_s"] for r in csv.DictReader(open(d + "/both/frames/timestamps.csv"))}
-for lap in ("0", "1"):
-    out = "%s/lap%d" % (d, int(lap) + 1)
-    os.makedirs(out + "/frames", exist_ok=True)
-    rows = [r for r in labels if r["traversal"] == lap]
-    with open(out + "/labels.csv", "w") as lf, open(out + "/frames/timestamps.csv", "w") as tf:
-        lf.write("frame,time,room,x,y,heading,traversal\n")
-        tf.write("name,time_s\n")
-        for i, r in enumerate(rows):
-            name = "%06d.png" % int(r["frame"])
-            shutil.copy("%s/both/frames/%s" % (d, name), "%s/frames/%06d.png" % (out, i))
-            lf.write("%d,%s,%s,%s,%s,%s,0\n" % (i, r["time"], r["room"], r["x"], r["y"], r["heading"]))
-            tf.write("%06d.png,%s\n" % (i, times[name]))
-PY
-}
-split_sim office
-split_sim home
+for world in office home; do "$repo/scripts/sim-laps.sh" "$T" "$world" "$work/$world"; done
 mkdir -p "$work/samples/lap1" "$work/samples/lap2"
 for i in $(seq 1 84); do
   lap=lap1 && [ "$i" -gt 40 ] && lap=lap2

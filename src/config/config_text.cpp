@@ -18,15 +18,6 @@ std::string sectionHelp(const std::string& path) {
   return "";
 }
 
-std::vector<std::string> split(const std::string& path) {
-  std::vector<std::string> parts;
-  std::size_t begin = 0;
-  for (std::size_t dot; (dot = path.find('.', begin)) != std::string::npos; begin = dot + 1)
-    parts.push_back(path.substr(begin, dot - begin));
-  if (!path.empty()) parts.push_back(path.substr(begin));
-  return parts;
-}
-
 DaemonConfig thesisConfig() {
   DaemonConfig thesis;
   applyMethodPreset("thesis", thesis);
@@ -92,7 +83,8 @@ std::string configDocsMarkdown() {
       "range, unit, help); the reader, validation, `--print-config`, the shipped file and this page follow.\n";
   std::string section = "-";
   for (const ConfigKey& key : daemonConfigKeys()) {
-    const std::string top = split(key.path).size() > 1 ? split(key.path).front() : "";
+    const std::size_t dot = key.path.find('.');
+    const std::string top = dot == std::string::npos ? "" : key.path.substr(0, dot);
     if (top != section) {
       section = top;
       out += "\n## " + (top.empty() ? std::string("Top level") : "`" + top + "`") + "\n\n";

@@ -249,12 +249,12 @@ MapNodes mapNodesOf(const TopologyParticleFilter& filter, const PlaceViews& view
   if (filter.observationCount() == 0) throw std::invalid_argument("the map has no places to localise against");
   const TopologyEstimate estimate = filter.estimate(1);
   const std::vector<int>& assignment = estimate.best.assignment;
-  out.node_count = estimate.best.node_count;
-  std::vector<std::vector<Fingerprint>> references(static_cast<std::size_t>(out.node_count));
+  const int node_count = estimate.best.node_count;
+  std::vector<std::vector<Fingerprint>> references(static_cast<std::size_t>(node_count));
   std::map<std::pair<int, int>, int> edges;
   for (std::size_t k = 0; k < assignment.size(); ++k) {
     const int node = assignment[k];
-    if (node < 0 || node >= out.node_count) continue;
+    if (node < 0 || node >= node_count) continue;
     if (const std::shared_ptr<const Fingerprint> f = filter.storedRepresentative(static_cast<int>(k)))
       references[static_cast<std::size_t>(node)].push_back(*f);
     if (k < views.size())
@@ -262,8 +262,8 @@ MapNodes mapNodesOf(const TopologyParticleFilter& filter, const PlaceViews& view
         if (view) references[static_cast<std::size_t>(node)].push_back(*view);
     if (k > 0 && assignment[k - 1] >= 0 && assignment[k - 1] != node) ++edges[{assignment[k - 1], node}];
   }
-  std::vector<int> index_of(static_cast<std::size_t>(out.node_count), -1);
-  for (int node = 0; node < out.node_count; ++node) {
+  std::vector<int> index_of(static_cast<std::size_t>(node_count), -1);
+  for (int node = 0; node < node_count; ++node) {
     auto& refs = references[static_cast<std::size_t>(node)];
     if (refs.empty()) continue;
     index_of[static_cast<std::size_t>(node)] = static_cast<int>(out.node_ids.size());
@@ -340,7 +340,7 @@ std::optional<FinishedPlace> ParticleFilterTopologyStage::advance(double budget_
       queue_.pop_front();
       representative_frames_.push_back(done.place.representative_frame);
       views_.resize(static_cast<std::size_t>(filter_->observationCount() - 1));
-      views_.push_back(done.place.views);
+      views_.push_back(std::move(done.place.views));  // the map's from now on; nothing later reads them
       if (spans_.empty() || done.place.first_frame > spans_.back().last_frame)
         spans_.push_back({done.place.first_frame, done.place.last_frame, filter_->observationCount() - 1});
       if (done.place.last_frame > last_mapped_frame_) {

@@ -9,30 +9,12 @@
 #   - toposlamd publishes, frame by frame, the answer `map` writes (place_t.node and match_node: the node the
 #     robot is in now, -1 "not a known node"), for every frame;
 #   - toposlamd with no map to localise in exits 2 naming the problem, and writes no map.
-# Usage: check_localize_only.sh TOPOSLAM TOPOSLAMD OUT_DIR
+# Usage: check_localize_only.sh TOPOSLAM TOPOSLAMD SCRIPTS_DIR OUT_DIR
 set -eu
-toposlam=$1 toposlamd=$2 out=$3
+toposlam=$1 toposlamd=$2 scripts=$3 out=$4
 rm -rf "$out" && mkdir -p "$out"
 fail() { echo "FAIL: $*"; exit 1; }
-"$toposlam" sim office --route loop2 --out "$out/both" >/dev/null 2>&1 || fail "the simulator"
-python3 - "$out" <<'PY' || fail "splitting the two laps"
-import csv, os, shutil, sys
-d = sys.argv[1]
-labels = list(csv.DictReader(open(d + "/both/labels.csv")))
-times = {r["name"]: r["time_s"] for r in csv.DictReader(open(d + "/both/frames/timestamps.csv"))}
-for lap in ("0", "1"):
-    out = "%s/lap%d" % (d, int(lap) + 1)
-    os.makedirs(out + "/frames")
-    rows = [r for r in labels if r["traversal"] == lap]
-    with open(out + "/labels.csv", "w") as lf, open(out + "/frames/timestamps.csv", "w") as tf:
-        lf.write("frame,x,y,heading\n")
-        tf.write("name,time_s\n")
-        for i, r in enumerate(rows):
-            name = "%06d.png" % int(r["frame"])
-            shutil.copy("%s/both/frames/%s" % (d, name), "%s/frames/%06d.png" % (out, i))
-            lf.write("%d,%s,%s,%s\n" % (i, r["x"], r["y"], r["heading"]))
-            tf.write("%06d.png,%s\n" % (i, times[name]))
-PY
+sh "$scripts/sim-laps.sh" "$toposlam" office "$out" || fail "the two laps of the simulator"
 "$toposlam" map "images:$out/lap1/frames" --out "$out/map" --quiet >"$out/map.txt" 2>&1 || fail "map: $(tail -3 "$out/map.txt")"
 before=$(cksum <"$out/map/map.tsm")
 "$toposlam" map "images:$out/lap2/frames" --localize-only --resume "$out/map/map.tsm" --out "$out/loc" --quiet \

@@ -35,7 +35,6 @@ MapNodes chainOfFour() {
     m.nodes.push_back(std::move(node));
   }
   m.successors = {{{1, 1.0}}, {{2, 1.0}}, {{3, 1.0}}, {}};
-  m.node_count = 4;
   return m;
 }
 

@@ -36,7 +36,6 @@ struct MapNodes {
   std::vector<int> node_ids;                  ///< per localised node: its id in the topology
   std::vector<LabelledPlace> nodes;           ///< per localised node: its representatives (label = id)
   std::vector<std::vector<PlaceRouteFilter::Successor>> successors;  ///< edges, weight = traversals
-  int node_count = 0;  ///< of the map's topology: every node, with or without a representative
 };
 
 /// One frame's answer.
